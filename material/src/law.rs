@@ -1,0 +1,96 @@
+//! The law interface shared by every constitutive model.
+//!
+//! The solver works in the total Lagrangian frame: a law receives the deformation gradient
+//! `F = I + Grad u` of one integration point and returns the second Piola-Kirchhoff stress `S`
+//! (Pa), the current dilatational wave speed `c` (m/s) used for the stable time step
+//! (`dt <= L / c`), and the energy it dissipated over the step (J per m^3 of reference volume),
+//! which the solver adds to the energy balance.
+//!
+//! History (viscoelastic internal variables, plastic strain) is stored by the solver in one
+//! contiguous buffer per element group, `history_len()` numbers per integration point; a law
+//! with `history_len() == 0` gets an empty slice and the solver allocates nothing for it.
+//! The slice holds the state at the start of the step on entry and must hold the state at the
+//! end of the step on return.
+
+use nalgebra::Matrix3;
+use thiserror::Error;
+
+/// 3x3 matrix of f64 (deformation gradient, stresses).
+pub type Mat3 = Matrix3<f64>;
+
+/// What a law returns for one integration point and one step.
+#[derive(Clone, Copy, Debug)]
+pub struct Response {
+    /// Second Piola-Kirchhoff stress S (Pa).
+    pub pk2: Mat3,
+    /// Current dilatational wave speed (m/s), including viscous moduli and stretch stiffening.
+    pub wave_speed: f64,
+    /// Energy dissipated during this step (J/m^3 of reference volume), >= 0.
+    pub dissipation: f64,
+    /// The point has reached its failure criterion and its element should be eroded.
+    pub failed: bool,
+}
+
+/// Why a law could not evaluate a state.
+#[derive(Clone, Debug, Error, PartialEq)]
+pub enum LawError {
+    /// det F <= 0: the element has inverted.
+    #[error("non-positive Jacobian det F = {0:.3e} (element inverted)")]
+    NonPositiveJacobian(f64),
+    /// The stress or wave speed is not finite.
+    #[error("non-finite stress or wave speed ({0})")]
+    NotFinite(&'static str),
+}
+
+/// A constitutive law. Implementations are plain data (parameters); all state lives in the
+/// history slice so that one law value serves every element of a group.
+pub trait Law: Sync + Send {
+    /// Reference density (kg/m^3).
+    fn density(&self) -> f64;
+    /// Number of history values per integration point (0 for a law without memory).
+    fn history_len(&self) -> usize {
+        0
+    }
+    /// Fill the history of one integration point with its initial (undeformed) state.
+    fn init_history(&self, _history: &mut [f64]) {}
+    /// Names of the history values, for output.
+    fn history_names(&self) -> Vec<String> {
+        Vec::new()
+    }
+    /// Dilatational wave speed of the undeformed material (m/s).
+    fn initial_wave_speed(&self) -> f64;
+    /// Evaluate the stress at deformation gradient `f` at the end of a step of length `dt` (s).
+    fn evaluate(&self, f: &Mat3, dt: f64, history: &mut [f64]) -> Result<Response, LawError>;
+}
+
+/// det F, refusing non-positive values.
+#[inline]
+pub fn checked_jacobian(f: &Mat3) -> Result<f64, LawError> {
+    let j = f.determinant();
+    if j > 0.0 && j.is_finite() {
+        Ok(j)
+    } else {
+        Err(LawError::NonPositiveJacobian(j))
+    }
+}
+
+/// Cauchy stress from PK2: sigma = F S F^T / J.
+#[inline]
+pub fn cauchy_from_pk2(f: &Mat3, s: &Mat3) -> Mat3 {
+    let j = f.determinant();
+    f * s * f.transpose() / j
+}
+
+/// PK2 from Kirchhoff stress: S = F^-1 tau F^-T.
+#[inline]
+pub fn pk2_from_kirchhoff(f: &Mat3, tau: &Mat3) -> Option<Mat3> {
+    let fi = f.try_inverse()?;
+    Some(fi * tau * fi.transpose())
+}
+
+/// Lame constants from Young's modulus and Poisson ratio: (lambda, mu).
+pub fn lame(e: f64, nu: f64) -> (f64, f64) {
+    let mu = e / (2.0 * (1.0 + nu));
+    let lambda = e * nu / ((1.0 + nu) * (1.0 - 2.0 * nu));
+    (lambda, mu)
+}

@@ -1,0 +1,63 @@
+//! Constitutive laws for palpa.
+//!
+//! Deformation gradient in; second Piola-Kirchhoff stress, current wave speed and dissipation
+//! out (see [`law`]). No mesh, no solver. The solver groups elements by material and resolves
+//! the [`Material`] enum once per group with [`with_law!`], so each group's loop is
+//! monomorphised for its law: no dynamic dispatch per element or integration point.
+#![warn(missing_docs)]
+
+pub mod law;
+pub mod linear_elastic;
+pub mod neo_hookean;
+pub mod quantity;
+pub mod spec;
+
+pub use law::{Law, LawError, Mat3, Response};
+pub use spec::MaterialSpec;
+
+/// Every law palpa knows, as plain parameter data.
+#[derive(Clone, Debug)]
+pub enum Material {
+    /// Linear isotropic elasticity.
+    LinearElastic(linear_elastic::LinearElastic),
+    /// Compressible neo-Hookean.
+    NeoHookean(neo_hookean::NeoHookean),
+}
+
+/// Run `$body` with `$l` bound to the concrete law inside a [`Material`]; the body is
+/// monomorphised per law.
+#[macro_export]
+macro_rules! with_law {
+    ($mat:expr, $l:ident => $body:expr) => {
+        match $mat {
+            $crate::Material::LinearElastic($l) => $body,
+            $crate::Material::NeoHookean($l) => $body,
+        }
+    };
+}
+
+impl Material {
+    /// Reference density (kg/m^3).
+    pub fn density(&self) -> f64 {
+        with_law!(self, l => l.density())
+    }
+    /// Initial dilatational wave speed (m/s).
+    pub fn initial_wave_speed(&self) -> f64 {
+        with_law!(self, l => l.initial_wave_speed())
+    }
+    /// History values per integration point.
+    pub fn history_len(&self) -> usize {
+        with_law!(self, l => l.history_len())
+    }
+    /// Names of the history values.
+    pub fn history_names(&self) -> Vec<String> {
+        with_law!(self, l => l.history_names())
+    }
+    /// Short name of the law.
+    pub fn law_name(&self) -> &'static str {
+        match self {
+            Material::LinearElastic(_) => "linear_elastic",
+            Material::NeoHookean(_) => "neo_hookean",
+        }
+    }
+}

@@ -1,0 +1,80 @@
+//! Compressible neo-Hookean solid (Simo & Pister form; Bonet & Wood, Nonlinear Continuum
+//! Mechanics for FEA, 2nd ed., eq. 6.28):
+//!
+//!   Psi = mu/2 (I1 - 3) - mu ln J + lambda/2 (ln J)^2,
+//!   S   = mu (I - C^-1) + lambda ln J C^-1.
+//!
+//! The spatial tangent is c = lambda/J I(x)I + 2 (mu - lambda ln J)/J II (Bonet & Wood eq. 6.40),
+//! so the dilatational wave speed in the current state is
+//!   c_d^2 = (lambda + 2 mu - 2 lambda ln J) / rho_0,
+//! which grows under compression (ln J < 0): the "stretch-stiffened" speed the time step needs.
+
+use crate::law::{checked_jacobian, Law, LawError, Mat3, Response};
+
+/// Compressible neo-Hookean law.
+#[derive(Clone, Debug)]
+pub struct NeoHookean {
+    /// Density (kg/m^3).
+    pub rho: f64,
+    /// First Lame constant (Pa).
+    pub lambda: f64,
+    /// Shear modulus (Pa).
+    pub mu: f64,
+}
+
+impl Law for NeoHookean {
+    fn density(&self) -> f64 {
+        self.rho
+    }
+    fn initial_wave_speed(&self) -> f64 {
+        ((self.lambda + 2.0 * self.mu) / self.rho).sqrt()
+    }
+    #[inline]
+    fn evaluate(&self, f: &Mat3, _dt: f64, _h: &mut [f64]) -> Result<Response, LawError> {
+        let j = checked_jacobian(f)?;
+        let c = f.transpose() * f;
+        let ci = c.try_inverse().ok_or(LawError::NotFinite("singular C"))?;
+        let lnj = j.ln();
+        let pk2 = Mat3::identity() * self.mu + ci * (self.lambda * lnj - self.mu);
+        let m = (self.lambda + 2.0 * self.mu - 2.0 * self.lambda * lnj).max(self.mu);
+        Ok(Response {
+            pk2,
+            wave_speed: (m / self.rho).sqrt(),
+            dissipation: 0.0,
+            failed: false,
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use nalgebra::Rotation3;
+
+    fn law() -> NeoHookean {
+        NeoHookean { rho: 1000.0, lambda: 2.0e6, mu: 1.0e6 }
+    }
+
+    #[test]
+    fn small_strain_matches_hooke() {
+        let eps = 1e-7;
+        let f = Mat3::new(1.0 + eps, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0);
+        let r = law().evaluate(&f, 0.0, &mut []).unwrap();
+        let s11 = (2.0e6 + 2.0e6) * eps;
+        assert!((r.pk2[(0, 0)] - s11).abs() < 1e-6 * s11);
+        assert!((r.pk2[(1, 1)] - 2.0e6 * eps).abs() < 1e-6 * s11);
+    }
+
+    #[test]
+    fn rigid_rotation_is_stress_free() {
+        let rot = Rotation3::from_euler_angles(0.3, 1.1, -0.7).into_inner();
+        let r = law().evaluate(&rot, 0.0, &mut []).unwrap();
+        assert!(r.pk2.norm() < 1e-8 * 1e6);
+    }
+
+    #[test]
+    fn inverted_point_is_an_error() {
+        let f = Mat3::new(-1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0);
+        assert!(matches!(law().evaluate(&f, 0.0, &mut []), Err(LawError::NonPositiveJacobian(_))));
+    }
+}
