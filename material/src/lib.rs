@@ -6,13 +6,20 @@
 //! monomorphised for its law: no dynamic dispatch per element or integration point.
 #![warn(missing_docs)]
 
+pub mod driver;
+pub mod foam;
 pub mod law;
+pub mod library;
 pub mod linear_elastic;
 pub mod neo_hookean;
+pub mod ogden;
+pub mod plasticity;
+pub mod principal;
 pub mod quantity;
 pub mod spec;
 
 pub use law::{Law, LawError, Mat3, Response};
+pub use library::named;
 pub use spec::MaterialSpec;
 
 /// Every law palpa knows, as plain parameter data.
@@ -22,6 +29,12 @@ pub enum Material {
     LinearElastic(linear_elastic::LinearElastic),
     /// Compressible neo-Hookean.
     NeoHookean(neo_hookean::NeoHookean),
+    /// N-term Ogden (original form) with optional Prony series.
+    Ogden(ogden::Ogden),
+    /// Simplified rubber/foam (MAT_181 style).
+    SimplifiedRubber(foam::Foam),
+    /// Piecewise-linear J2 plasticity (MAT_024 style).
+    PiecewiseLinearPlasticity(plasticity::Plasticity),
 }
 
 /// Run `$body` with `$l` bound to the concrete law inside a [`Material`]; the body is
@@ -32,6 +45,9 @@ macro_rules! with_law {
         match $mat {
             $crate::Material::LinearElastic($l) => $body,
             $crate::Material::NeoHookean($l) => $body,
+            $crate::Material::Ogden($l) => $body,
+            $crate::Material::SimplifiedRubber($l) => $body,
+            $crate::Material::PiecewiseLinearPlasticity($l) => $body,
         }
     };
 }
@@ -58,6 +74,9 @@ impl Material {
         match self {
             Material::LinearElastic(_) => "linear_elastic",
             Material::NeoHookean(_) => "neo_hookean",
+            Material::Ogden(_) => "ogden",
+            Material::SimplifiedRubber(_) => "simplified_rubber",
+            Material::PiecewiseLinearPlasticity(_) => "piecewise_linear_plasticity",
         }
     }
 }

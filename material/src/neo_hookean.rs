@@ -52,7 +52,11 @@ mod tests {
     use nalgebra::Rotation3;
 
     fn law() -> NeoHookean {
-        NeoHookean { rho: 1000.0, lambda: 2.0e6, mu: 1.0e6 }
+        NeoHookean {
+            rho: 1000.0,
+            lambda: 2.0e6,
+            mu: 1.0e6,
+        }
     }
 
     #[test]
@@ -75,6 +79,9 @@ mod tests {
     #[test]
     fn inverted_point_is_an_error() {
         let f = Mat3::new(-1.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0);
-        assert!(matches!(law().evaluate(&f, 0.0, &mut []), Err(LawError::NonPositiveJacobian(_))));
+        assert!(matches!(
+            law().evaluate(&f, 0.0, &mut []),
+            Err(LawError::NonPositiveJacobian(_))
+        ));
     }
 }

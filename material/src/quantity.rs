@@ -46,7 +46,11 @@ impl Dim {
     pub const STIFFNESS: Dim = Dim(1, 0, -2);
 
     fn add(self, o: Dim, sign: i8) -> Dim {
-        Dim(self.0 + sign * o.0, self.1 + sign * o.1, self.2 + sign * o.2)
+        Dim(
+            self.0 + sign * o.0,
+            self.1 + sign * o.1,
+            self.2 + sign * o.2,
+        )
     }
 
     /// A human name for error messages.
@@ -113,7 +117,8 @@ impl Quantity {
                     || c == '+'
                     || c == '-'
                     || ((c == 'e' || c == 'E')
-                        && t[i + 1..].starts_with(|n: char| n.is_ascii_digit() || n == '-' || n == '+')))
+                        && t[i + 1..]
+                            .starts_with(|n: char| n.is_ascii_digit() || n == '-' || n == '+')))
             })
             .map(|(i, _)| i)
             .unwrap_or(t.len());
@@ -127,7 +132,10 @@ impl Quantity {
             return Ok(Quantity::si(v));
         }
         let (f, d) = parse_unit_expr(unit)?;
-        Ok(Quantity { si: v * f, dim: Some(d) })
+        Ok(Quantity {
+            si: v * f,
+            dim: Some(d),
+        })
     }
 }
 
@@ -186,7 +194,10 @@ fn parse_unit_expr(u: &str) -> Result<(f64, Dim), String> {
     let mut factor = 1.0;
     let mut dim = Dim::NONE;
     for (part, sign) in [(num, 1i8), (den.unwrap_or(""), -1i8)] {
-        for tok in part.split(|c: char| c == '*' || c == ' ' || c == '.').filter(|s| !s.is_empty()) {
+        for tok in part
+            .split(|c: char| c == '*' || c == ' ' || c == '.')
+            .filter(|s| !s.is_empty())
+        {
             let (sym, pow) = match tok.split_once('^') {
                 Some((s, p)) => (
                     s,
@@ -307,7 +318,10 @@ mod tests {
     fn rejects_unknown_unit_and_wrong_dimension() {
         let e = Quantity::parse("40 kPascal").unwrap_err();
         assert!(e.contains("unknown unit `kPascal`"), "{e}");
-        let e = Quantity::parse("40 kPa").unwrap().get(Dim::LENGTH).unwrap_err();
+        let e = Quantity::parse("40 kPa")
+            .unwrap()
+            .get(Dim::LENGTH)
+            .unwrap_err();
         assert!(e.contains("expected a length"), "{e}");
         assert!(Quantity::parse("kPa").is_err());
     }
