@@ -27,7 +27,7 @@
 //! bulk_modulus = "2 GPa"
 //! shear_modulus = "40 kPa"       # without a curve: P = G (l - l^-2)
 //! damping = 0.40
-//! # curve = [[0.5, "-52.5 kPa"], [1.0, 0], [1.5, "42.2 kPa"]]  # nominal stress vs stretch
+//! # curve = [[0.5, "-140 kPa"], [1.0, 0], [1.5, "42.2 kPa"]]  # nominal stress vs stretch
 //! # curve_file = "flesh.csv"     # rows: stretch, stress (plain numbers are Pa; "12 kPa" allowed)
 //!
 //! [materials.ribs]
@@ -353,9 +353,11 @@ impl OgdenSpec {
         let prony_on = match self.prony_on.as_deref() {
             None | Some("green_lagrange") => PronyOn::GreenLagrange,
             Some("deviatoric") => PronyOn::Deviatoric,
-            Some(o) => return Err(format!(
+            Some(o) => {
+                return Err(format!(
                 "material `{name}`: `prony_on` must be `green_lagrange` or `deviatoric`, got `{o}`"
-            )),
+            ))
+            }
         };
         let mut prony = Vec::with_capacity(self.prony.len());
         for (i, t) in self.prony.iter().enumerate() {
