@@ -1,0 +1,346 @@
+//! Indenter motion: prescribed displacement or velocity curves, and force control.
+//!
+//! An indenter translates along its unit pressing direction `d`; its offset from the initial
+//! placement is `u(t) = s(t) d`, with `s` the travel (m).
+//!
+//! **Curves** ([`Curve`]) give a scalar of time:
+//! - `smooth_step`: `a * S((t - t0) / T)` with the quintic `S(r) = 10 r^3 - 15 r^4 + 6 r^5`
+//!   (`S(0) = 0`, `S(1) = 1`, zero velocity and acceleration at both ends; peak rate
+//!   `1.875 a / T`), held at `a` after `t0 + T`. "15 mm in 25 ms" is
+//!   `{ curve = "smooth_step", amplitude = 0.015, duration = 0.025 }`.
+//! - `ramp`: linear from 0 to `a` over `[t0, t0 + T]`, then held.
+//! - `table`: piecewise linear through `(t, value)` points, held constant outside.
+//! - `constant`.
+//!
+//! **Prescribed displacement** uses the curve as `s(t)`; **prescribed velocity** as `ds/dt`,
+//! integrated with the midpoint rule over each step.
+//!
+//! **Force control** ([`ForceControl`]) presses along `d` until the reaction
+//! `R = -F_body_on_indenter . d` reaches `target`, then holds it. The law is a velocity command,
+//! evaluated once per step after the contact forces are known:
+//! 1. `R_f`: first-order low-pass of `R`, time constant `filter_time` (explicit dynamics makes the
+//!    raw contact force ring);
+//! 2. before first contact: `v = approach_speed`;
+//! 3. after first contact at travel `s_c` and time `t_c`: reference `F_ref = target * min(1, (t - t_c)
+//!    / ramp_time)`, secant stiffness `k_s = R_f / max(s - s_c, 1e-9 m)`, and
+//!    `v = clamp((F_ref - R_f) / (k_s * time_constant), -approach_speed, approach_speed)`.
+//!
+//! For a body whose force grows with depth as `R = k(s - s_c)` this is a first-order lag of
+//! time constant `time_constant` towards `F_ref`, independent of `k` (the secant stiffness is
+//! measured on line, so no stiffness needs to be known); a stiffening body (Hertz: tangent =
+//! 1.5 secant) only makes it faster. Since position integrates velocity, the law has no
+//! steady-state error for a constant target on an elastic body; on a relaxing (viscoelastic) body it
+//! follows the relaxation with a lag error about `time_constant * |dR/dt|_relax`. Saturation at
+//! `approach_speed` bounds the speed in every phase, so a wrong stiffness estimate can never drive
+//! the indenter away. Keep `filter_time` a few times below `time_constant` for stability.
+
+use serde::Deserialize;
+
+/// A scalar function of time (value unit set by its use: m, m/s).
+#[derive(Clone, Debug, Deserialize, PartialEq)]
+#[serde(tag = "curve", rename_all = "snake_case", deny_unknown_fields)]
+pub enum Curve {
+    /// Quintic smooth step from 0 to `amplitude` over `[start, start + duration]`, then held.
+    SmoothStep {
+        /// Final value.
+        amplitude: f64,
+        /// Duration of the transition (s).
+        duration: f64,
+        /// Start time (s). Default 0.
+        #[serde(default)]
+        start: f64,
+    },
+    /// Linear ramp from 0 to `amplitude` over `[start, start + duration]`, then held.
+    Ramp {
+        /// Final value.
+        amplitude: f64,
+        /// Duration of the ramp (s).
+        duration: f64,
+        /// Start time (s). Default 0.
+        #[serde(default)]
+        start: f64,
+    },
+    /// Piecewise linear through `[t (s), value]` points (sorted by time), held outside.
+    Table {
+        /// `[time (s), value]` pairs, increasing in time.
+        points: Vec<[f64; 2]>,
+    },
+    /// A constant value.
+    Constant {
+        /// The value.
+        value: f64,
+    },
+}
+
+impl Curve {
+    /// Value at time `t` (s).
+    pub fn value(&self, t: f64) -> f64 {
+        match self {
+            Curve::SmoothStep {
+                amplitude,
+                duration,
+                start,
+            } => {
+                let r = ((t - start) / duration).clamp(0.0, 1.0);
+                amplitude * r * r * r * (10.0 + r * (-15.0 + 6.0 * r))
+            }
+            Curve::Ramp {
+                amplitude,
+                duration,
+                start,
+            } => amplitude * ((t - start) / duration).clamp(0.0, 1.0),
+            Curve::Table { points } => table(points, t).0,
+            Curve::Constant { value } => *value,
+        }
+    }
+
+    /// Time derivative at `t` (unit of the value per s).
+    pub fn rate(&self, t: f64) -> f64 {
+        match self {
+            Curve::SmoothStep {
+                amplitude,
+                duration,
+                start,
+            } => {
+                let r = (t - start) / duration;
+                if !(0.0..=1.0).contains(&r) {
+                    return 0.0;
+                }
+                amplitude / duration * 30.0 * r * r * (1.0 - r) * (1.0 - r)
+            }
+            Curve::Ramp {
+                amplitude,
+                duration,
+                start,
+            } => {
+                if t >= *start && t <= start + duration {
+                    amplitude / duration
+                } else {
+                    0.0
+                }
+            }
+            Curve::Table { points } => table(points, t).1,
+            Curve::Constant { .. } => 0.0,
+        }
+    }
+
+    pub(crate) fn validate(&self) -> Result<(), String> {
+        match self {
+            Curve::SmoothStep {
+                duration,
+                amplitude,
+                start,
+            }
+            | Curve::Ramp {
+                duration,
+                amplitude,
+                start,
+            } => {
+                if !(*duration > 0.0) || !amplitude.is_finite() || !start.is_finite() {
+                    return Err("curve needs a positive duration and finite amplitude".into());
+                }
+            }
+            Curve::Table { points } => {
+                if points.is_empty() {
+                    return Err("table curve has no points".into());
+                }
+                if points.windows(2).any(|w| !(w[1][0] > w[0][0])) {
+                    return Err("table curve times must increase strictly".into());
+                }
+            }
+            Curve::Constant { value } => {
+                if !value.is_finite() {
+                    return Err("constant curve is not finite".into());
+                }
+            }
+        }
+        Ok(())
+    }
+}
+
+fn table(points: &[[f64; 2]], t: f64) -> (f64, f64) {
+    let n = points.len();
+    if t <= points[0][0] {
+        return (points[0][1], 0.0);
+    }
+    if t >= points[n - 1][0] {
+        return (points[n - 1][1], 0.0);
+    }
+    // Binary search for the segment.
+    let i = points.partition_point(|p| p[0] <= t) - 1;
+    let (a, b) = (points[i], points[i + 1]);
+    let slope = (b[1] - a[1]) / (b[0] - a[0]);
+    (a[1] + slope * (t - a[0]), slope)
+}
+
+/// Force-control parameters (SI). See the module doc for the law.
+#[derive(Clone, Debug, Deserialize, PartialEq)]
+#[serde(deny_unknown_fields)]
+pub struct ForceControl {
+    /// Target reaction force along the pressing direction (N).
+    pub target: f64,
+    /// Time to ramp the force reference from 0 to `target`, counted from first contact (s).
+    /// Default 0 (step).
+    #[serde(default)]
+    pub ramp_time: f64,
+    /// Speed before contact, and speed limit at all times (m/s). Default 0.1.
+    #[serde(default = "default_approach")]
+    pub approach_speed: f64,
+    /// Closed-loop time constant (s). Default 5 ms.
+    #[serde(default = "default_tau")]
+    pub time_constant: f64,
+    /// Low-pass time constant of the measured force (s). Default 0.5 ms.
+    #[serde(default = "default_filter")]
+    pub filter_time: f64,
+}
+
+fn default_approach() -> f64 {
+    0.1
+}
+fn default_tau() -> f64 {
+    5e-3
+}
+fn default_filter() -> f64 {
+    5e-4
+}
+
+impl ForceControl {
+    /// Force control towards `target` (N) with default gains.
+    pub fn new(target: f64) -> Self {
+        ForceControl {
+            target,
+            ramp_time: 0.0,
+            approach_speed: default_approach(),
+            time_constant: default_tau(),
+            filter_time: default_filter(),
+        }
+    }
+}
+
+/// How an indenter moves along its direction.
+#[derive(Clone, Debug, Deserialize, PartialEq)]
+#[serde(tag = "kind", rename_all = "snake_case")]
+pub enum MotionSpec {
+    /// Does not move.
+    Fixed,
+    /// Prescribed travel `s(t)` (m) along the direction.
+    Displacement {
+        /// Travel (m) versus time.
+        #[serde(flatten)]
+        curve: Curve,
+    },
+    /// Prescribed speed `ds/dt` (m/s) along the direction.
+    Velocity {
+        /// Speed (m/s) versus time.
+        #[serde(flatten)]
+        curve: Curve,
+    },
+    /// Force control (see [`ForceControl`]).
+    Force(ForceControl),
+}
+
+impl MotionSpec {
+    pub(crate) fn validate(&self) -> Result<(), String> {
+        match self {
+            MotionSpec::Fixed => Ok(()),
+            MotionSpec::Displacement { curve } | MotionSpec::Velocity { curve } => curve.validate(),
+            MotionSpec::Force(f) => {
+                let ok = f.target.is_finite()
+                    && f.ramp_time >= 0.0
+                    && f.approach_speed > 0.0
+                    && f.time_constant > 0.0
+                    && f.filter_time >= 0.0;
+                if ok {
+                    Ok(())
+                } else {
+                    Err("force control needs finite target, ramp_time >= 0, approach_speed > 0, time_constant > 0, filter_time >= 0".into())
+                }
+            }
+        }
+    }
+}
+
+/// Run-time state of a motion along the direction.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct MotionState {
+    /// Travel (m).
+    pub s: f64,
+    /// Travel rate (m/s).
+    pub v: f64,
+    /// Filtered reaction (N), force control.
+    pub r_filt: f64,
+    /// Travel and time at first contact.
+    pub contact: Option<(f64, f64)>,
+    /// Time of the last update.
+    pub t: Option<f64>,
+}
+
+impl MotionState {
+    /// Advance the travel to time `t` (before the contact evaluation).
+    pub fn advance(&mut self, spec: &MotionSpec, t: f64) {
+        let t_prev = self.t.unwrap_or(t);
+        match spec {
+            MotionSpec::Fixed => {
+                self.s = 0.0;
+                self.v = 0.0;
+            }
+            MotionSpec::Displacement { curve } => {
+                self.s = curve.value(t);
+                self.v = curve.rate(t);
+            }
+            MotionSpec::Velocity { curve } => {
+                if self.t.is_some() {
+                    self.s += curve.value(0.5 * (t + t_prev)) * (t - t_prev);
+                }
+                self.v = curve.value(t);
+            }
+            MotionSpec::Force(_) => {
+                // Velocity command from the previous step.
+                self.s += self.v * (t - t_prev);
+            }
+        }
+        self.t = Some(t);
+    }
+
+    /// After the contact evaluation at time `t`: record first contact and update the force law.
+    /// `reaction` is the force the body exerts on the indenter along `-direction` (N), `dt` the step.
+    pub fn after_contact(
+        &mut self,
+        spec: &MotionSpec,
+        t: f64,
+        dt: f64,
+        reaction: f64,
+        touching: bool,
+    ) {
+        if self.contact.is_none() && touching {
+            self.contact = Some((self.s, t));
+        }
+        if let MotionSpec::Force(fc) = spec {
+            let a = if fc.filter_time > 0.0 {
+                1.0 - (-dt / fc.filter_time).exp()
+            } else {
+                1.0
+            };
+            self.r_filt += a * (reaction - self.r_filt);
+            self.v = match self.contact {
+                None => fc.approach_speed,
+                Some((s_c, t_c)) => {
+                    let f_ref = if fc.ramp_time > 0.0 {
+                        fc.target * ((t - t_c) / fc.ramp_time).min(1.0)
+                    } else {
+                        fc.target
+                    };
+                    let k_s = self.r_filt.max(0.0) / (self.s - s_c).max(1e-9);
+                    let e = f_ref - self.r_filt;
+                    let denom = k_s * fc.time_constant;
+                    let v = if denom > 0.0 {
+                        e / denom
+                    } else {
+                        fc.approach_speed * e.signum()
+                    };
+                    v.clamp(-fc.approach_speed, fc.approach_speed)
+                }
+            };
+        }
+    }
+}
