@@ -1,1 +1,13 @@
-fn main(){}
+//! `palpa`: the command-line front of the palpa explicit solver.
+
+mod cli;
+
+use clap::Parser;
+
+fn main() {
+    let args = cli::Cli::parse();
+    if let Err(e) = cli::dispatch(args) {
+        eprintln!("error: {e}");
+        std::process::exit(1);
+    }
+}

@@ -2,6 +2,18 @@
 //! time loop, scenes, and output.
 #![warn(missing_docs)]
 
+pub mod bc;
+pub mod curve;
+pub mod element;
+pub mod forces;
+pub mod generate;
+pub mod hex;
 pub mod mesh;
+pub mod model;
+pub mod output;
+pub mod run;
+pub mod scene;
+pub mod simulation;
 
 pub use mesh::Mesh;
+pub use model::{Model, Part, SolverError};

@@ -72,7 +72,8 @@ impl Mesh {
 
     /// Faces that belong to exactly one element, in element order.
     pub fn boundary_faces(&self) -> Vec<BoundaryFace> {
-        let mut seen: HashMap<[u32; 4], (u32, u8, usize)> = HashMap::with_capacity(self.elements.len() * 3);
+        let mut seen: HashMap<[u32; 4], (u32, u8, usize)> =
+            HashMap::with_capacity(self.elements.len() * 3);
         for (e, conn) in self.elements.iter().enumerate() {
             for (lf, f) in FACES.iter().enumerate() {
                 let mut key = [conn[f[0]], conn[f[1]], conn[f[2]], conn[f[3]]];
@@ -87,7 +88,11 @@ impl Mesh {
             .map(|(e, lf, _)| {
                 let c = self.elements[e as usize];
                 let f = FACES[lf as usize];
-                BoundaryFace { element: e, local: lf, nodes: [c[f[0]], c[f[1]], c[f[2]], c[f[3]]] }
+                BoundaryFace {
+                    element: e,
+                    local: lf,
+                    nodes: [c[f[0]], c[f[1]], c[f[2]], c[f[3]]],
+                }
             })
             .collect();
         out.sort_by_key(|f| (f.element, f.local));

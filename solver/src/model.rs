@@ -1,0 +1,424 @@
+//! The assembled model: element groups in struct-of-arrays form, lumped masses, selective mass
+//! scaling, and the node-to-element gather table for race-free parallel assembly.
+//!
+//! Elements are grouped by part (one law and one formulation per group). Each group stores
+//! its reference data contiguously: connectivity, mean or centre gradients, volumes,
+//! hourglass vectors (one-point only), Gauss-point gradients (fully integrated only), and one
+//! history buffer with `history_len * n_ip` values per element, empty for a law without history.
+//!
+//! Lumped mass: m_a = sum_e rho_e int_Ve N_a dV (row sum of the consistent mass, exact by 2x2x2
+//! quadrature), which is rho V / 8 per node for a parallelepiped.
+//!
+//! Selective mass scaling (LS-DYNA DT2MS < 0 style): for a target step dt_t and step factor
+//! s_f, an element whose own step s_f L/c is below dt_t gets its density multiplied by
+//! (dt_t / (s_f L/c))^2, which raises its step to exactly dt_t; other elements are untouched.
+//! The added mass is reported per part.
+
+use crate::element::{Formulation, HourglassForm};
+use crate::hex::{element_geometry, hourglass_gamma, max_face_area};
+use crate::mesh::Mesh;
+use material::Material;
+use std::fmt;
+
+/// One part: a name, a law and an element formulation.
+#[derive(Clone, Debug)]
+pub struct Part {
+    /// Part name.
+    pub name: String,
+    /// Its law.
+    pub material: Material,
+    /// Its element formulation.
+    pub formulation: Formulation,
+}
+
+/// Why a model could not be built or run.
+#[derive(Debug, Clone, PartialEq)]
+pub enum SolverError {
+    /// An element has a non-positive Jacobian in the reference configuration.
+    InvertedElement {
+        /// Element id (0-based, as ParaView shows cell ids).
+        element: u32,
+        /// Part name.
+        part: String,
+        /// Local corner or Gauss point.
+        corner: usize,
+        /// The determinant found.
+        det: f64,
+    },
+    /// A law failed during the run.
+    ElementFailure {
+        /// Element id.
+        element: u32,
+        /// Part name.
+        part: String,
+        /// Simulated time (s).
+        time: f64,
+        /// What the law said.
+        reason: String,
+    },
+    /// Mass scaling would add more than the allowed fraction.
+    MassScalingLimit {
+        /// Added mass / physical mass of the whole model.
+        added_fraction: f64,
+        /// Limit.
+        limit: f64,
+        /// Worst part.
+        part: String,
+    },
+    /// Any other invalid input.
+    Invalid(String),
+}
+
+impl fmt::Display for SolverError {
+    fn fmt(&self, f: &mut fmt::Formatter) -> fmt::Result {
+        match self {
+            SolverError::InvertedElement { element, part, corner, det } => write!(
+                f,
+                "element {element} (part `{part}`) has a non-positive Jacobian {det:.3e} at corner {corner}: \
+                 it is inverted or degenerate; check its node order (VTK_HEXAHEDRON) and coordinates"
+            ),
+            SolverError::ElementFailure { element, part, time, reason } => write!(
+                f,
+                "element {element} (part `{part}`) failed at t = {:.6} ms: {reason}",
+                time * 1e3
+            ),
+            SolverError::MassScalingLimit { added_fraction, limit, part } => write!(
+                f,
+                "mass scaling would add {:.2} % of the physical mass (limit {:.2} %; most in part `{part}`): \
+                 lower the target time step or raise mass_scaling.max_added",
+                added_fraction * 100.0,
+                limit * 100.0
+            ),
+            SolverError::Invalid(s) => f.write_str(s),
+        }
+    }
+}
+
+impl std::error::Error for SolverError {}
+
+/// Partial results of one chunk of the element loop.
+#[derive(Clone, Debug, Default)]
+pub struct ChunkOut {
+    /// Smallest element step.
+    pub dt_min: f64,
+    /// Element with the smallest step (global id).
+    pub dt_elem: u32,
+    /// Stored hourglass energy.
+    pub hg_stored: f64,
+    /// Hourglass power.
+    pub hg_power: f64,
+    /// Bulk-viscous power.
+    pub bulk_power: f64,
+    /// Law dissipation.
+    pub law_dissipation: f64,
+    /// First error: (global element, message).
+    pub error: Option<(u32, String)>,
+    /// First failed element.
+    pub failed: Option<u32>,
+}
+
+/// A group of elements with one law and one formulation (struct of arrays).
+#[derive(Clone, Debug)]
+pub struct Group {
+    /// Part index.
+    pub part: usize,
+    /// Global element ids.
+    pub elements: Vec<u32>,
+    /// Connectivity.
+    pub conn: Vec<[u32; 8]>,
+    /// Mean gradient (one-point) or centre gradient (full), [component][node].
+    pub grad: Vec<[[f64; 8]; 3]>,
+    /// Reference volumes (m^3).
+    pub vol0: Vec<f64>,
+    /// Hourglass vectors (one-point only).
+    pub gamma: Vec<[[f64; 8]; 4]>,
+    /// Hourglass stiffness a_s (one-point stiffness form only).
+    pub hg_stiffness: Vec<f64>,
+    /// Gauss-point gradients (full only).
+    pub gp_grad: Vec<[[[f64; 8]; 3]; 8]>,
+    /// Gauss-point weights (full only).
+    pub gp_weight: Vec<[f64; 8]>,
+    /// History values per element (history_len * n_ip).
+    pub history_stride: usize,
+    /// History buffer (empty for a law without history).
+    pub history: Vec<f64>,
+    /// Density scale factors from mass scaling (empty if none).
+    pub density_scale: Vec<f64>,
+    /// Offset of this group's elements in the element-force slot buffer.
+    pub slot_offset: usize,
+    /// Scratch: per-chunk partial results.
+    pub chunks: Vec<ChunkOut>,
+    /// Eroded flags (empty unless the law can fail).
+    pub eroded: Vec<bool>,
+}
+
+/// Elements per parallel chunk. Fixed, so partial sums are formed in the same order for any
+/// thread count (bitwise determinism).
+pub const CHUNK: usize = 512;
+
+/// Mass-scaling request.
+#[derive(Clone, Copy, Debug)]
+pub struct MassScaling {
+    /// Target time step (s).
+    pub target_dt: f64,
+    /// Largest allowed added mass as a fraction of physical mass.
+    pub max_added: f64,
+}
+
+/// Per-part mass report.
+#[derive(Clone, Debug, Default)]
+pub struct PartMass {
+    /// Part name.
+    pub name: String,
+    /// Physical mass (kg).
+    pub physical: f64,
+    /// Added mass (kg).
+    pub added: f64,
+    /// Elements in the part.
+    pub elements: usize,
+    /// Elements that received mass.
+    pub scaled_elements: usize,
+}
+
+/// The assembled model.
+#[derive(Clone, Debug)]
+pub struct Model {
+    /// The mesh.
+    pub mesh: Mesh,
+    /// Parts.
+    pub parts: Vec<Part>,
+    /// Element groups.
+    pub groups: Vec<Group>,
+    /// Nodal mass including mass scaling (kg).
+    pub mass: Vec<f64>,
+    /// Per-part mass report.
+    pub part_mass: Vec<PartMass>,
+    /// Gather table: for node n, slots gather_idx[gather_ptr[n]..gather_ptr[n+1]] (slot = 8 * element slot + local node).
+    pub gather_ptr: Vec<u32>,
+    /// Gather entries.
+    pub gather_idx: Vec<u32>,
+    /// Total element slots.
+    pub n_slots: usize,
+    /// Initial critical step without mass scaling (s), and its element.
+    pub initial_dt: (f64, u32),
+    /// Initial critical step with mass scaling (s).
+    pub scaled_dt: f64,
+}
+
+/// Initial critical step of one element (s): L / c with L = V / A_max.
+pub fn initial_element_dt(x: &[[f64; 3]; 8], volume: f64, c: f64) -> f64 {
+    volume / max_face_area(x) / c
+}
+
+impl Model {
+    /// Build the model. `dt_factor` is the time-step safety factor (used by mass scaling).
+    pub fn build(
+        mesh: Mesh,
+        parts: Vec<Part>,
+        mass_scaling: Option<MassScaling>,
+        dt_factor: f64,
+    ) -> Result<Model, SolverError> {
+        if mesh.element_part.len() != mesh.elements.len() {
+            return Err(SolverError::Invalid("every element needs a part".into()));
+        }
+        for (e, c) in mesh.elements.iter().enumerate() {
+            for &n in c {
+                if n as usize >= mesh.nodes.len() {
+                    return Err(SolverError::Invalid(format!(
+                        "element {e} refers to node {n}, but the mesh has {} nodes",
+                        mesh.nodes.len()
+                    )));
+                }
+            }
+        }
+        let mut mass = vec![0.0; mesh.nodes.len()];
+        let mut groups = Vec::new();
+        let mut part_mass: Vec<PartMass> = parts
+            .iter()
+            .map(|p| PartMass {
+                name: p.name.clone(),
+                ..Default::default()
+            })
+            .collect();
+        let mut slot_offset = 0;
+        let mut initial_dt = (f64::INFINITY, 0u32);
+        let mut scaled_dt = f64::INFINITY;
+        for (pi, part) in parts.iter().enumerate() {
+            let elems: Vec<u32> = (0..mesh.elements.len() as u32)
+                .filter(|&e| mesh.element_part[e as usize] as usize == pi)
+                .collect();
+            if elems.is_empty() {
+                continue;
+            }
+            let n = elems.len();
+            let form = part.formulation;
+            let law = &part.material;
+            let rho = law.density();
+            let c0 = law.initial_wave_speed();
+            let n_ip = form.n_ip();
+            let stride = law.history_len() * n_ip;
+            let mut g = Group {
+                part: pi,
+                elements: elems.clone(),
+                conn: Vec::with_capacity(n),
+                grad: Vec::with_capacity(n),
+                vol0: Vec::with_capacity(n),
+                gamma: Vec::new(),
+                hg_stiffness: Vec::new(),
+                gp_grad: Vec::new(),
+                gp_weight: Vec::new(),
+                history_stride: stride,
+                history: vec![0.0; stride * n],
+                density_scale: Vec::new(),
+                slot_offset,
+                chunks: vec![ChunkOut::default(); n.div_ceil(CHUNK)],
+                eroded: Vec::new(),
+            };
+            let mut scale = Vec::with_capacity(n);
+            let lambda2mu = rho * c0 * c0;
+            for &e in &elems {
+                let conn = mesh.elements[e as usize];
+                let x: [[f64; 3]; 8] = std::array::from_fn(|a| mesh.nodes[conn[a] as usize]);
+                let geo =
+                    element_geometry(&x).map_err(|(corner, det)| SolverError::InvertedElement {
+                        element: e,
+                        part: part.name.clone(),
+                        corner,
+                        det,
+                    })?;
+                g.conn.push(conn);
+                g.vol0.push(geo.volume);
+                match form {
+                    Formulation::OnePoint(hg) => {
+                        g.grad.push(geo.mean_grad);
+                        g.gamma.push(hourglass_gamma(&x, &geo.mean_grad));
+                        if hg.form == HourglassForm::Stiffness {
+                            let mut bb = 0.0;
+                            for i in 0..3 {
+                                for a in 0..8 {
+                                    let b = geo.mean_grad[i][a] * geo.volume;
+                                    bb += b * b;
+                                }
+                            }
+                            g.hg_stiffness
+                                .push(hg.coefficient * lambda2mu * bb / (3.0 * geo.volume) / 64.0);
+                        }
+                    }
+                    Formulation::Full { .. } => {
+                        g.grad.push(geo.centre_grad);
+                        g.gp_grad.push(geo.gp_grad);
+                        g.gp_weight.push(geo.gp_weight);
+                    }
+                }
+                let dte = initial_element_dt(&x, geo.volume, c0);
+                if dte < initial_dt.0 {
+                    initial_dt = (dte, e);
+                }
+                let mut s = 1.0;
+                if let Some(ms) = mass_scaling {
+                    let own = dt_factor * dte;
+                    if own < ms.target_dt {
+                        s = (ms.target_dt / own).powi(2);
+                        part_mass[pi].scaled_elements += 1;
+                    }
+                }
+                scaled_dt = scaled_dt.min(dte * s.sqrt());
+                scale.push(s);
+                part_mass[pi].physical += rho * geo.volume;
+                part_mass[pi].added += rho * geo.volume * (s - 1.0);
+                part_mass[pi].elements += 1;
+                for a in 0..8 {
+                    mass[conn[a] as usize] += rho * s * geo.lumped_volume[a];
+                }
+            }
+            if mass_scaling.is_some() {
+                g.density_scale = scale;
+            }
+            if stride > 0 {
+                let hl = law.history_len();
+                material::with_law!(law, l => {
+                    for chunk in g.history.chunks_mut(hl) {
+                        material::Law::init_history(l, chunk);
+                    }
+                });
+            }
+            slot_offset += n;
+            groups.push(g);
+        }
+        if let Some(ms) = mass_scaling {
+            let phys: f64 = part_mass.iter().map(|p| p.physical).sum();
+            let added: f64 = part_mass.iter().map(|p| p.added).sum();
+            if added > ms.max_added * phys {
+                let worst = part_mass
+                    .iter()
+                    .max_by(|a, b| a.added.partial_cmp(&b.added).unwrap())
+                    .map(|p| p.name.clone())
+                    .unwrap_or_default();
+                return Err(SolverError::MassScalingLimit {
+                    added_fraction: added / phys,
+                    limit: ms.max_added,
+                    part: worst,
+                });
+            }
+        }
+        if let Some(n) = mass.iter().position(|&m| !(m > 0.0)) {
+            return Err(SolverError::Invalid(format!(
+                "node {n} belongs to no element (zero mass); remove it"
+            )));
+        }
+        // Gather table.
+        let nn = mesh.nodes.len();
+        let mut count = vec![0u32; nn + 1];
+        for g in &groups {
+            for c in &g.conn {
+                for &n in c {
+                    count[n as usize + 1] += 1;
+                }
+            }
+        }
+        for i in 0..nn {
+            count[i + 1] += count[i];
+        }
+        let mut fill = count.clone();
+        let mut idx = vec![0u32; count[nn] as usize];
+        for g in &groups {
+            for (k, c) in g.conn.iter().enumerate() {
+                let slot = g.slot_offset + k;
+                for (a, &n) in c.iter().enumerate() {
+                    idx[fill[n as usize] as usize] = (slot * 8 + a) as u32;
+                    fill[n as usize] += 1;
+                }
+            }
+        }
+        Ok(Model {
+            mesh,
+            parts,
+            groups,
+            mass,
+            part_mass,
+            gather_ptr: count,
+            gather_idx: idx,
+            n_slots: slot_offset,
+            initial_dt,
+            scaled_dt,
+        })
+    }
+
+    /// Total physical mass (kg).
+    pub fn physical_mass(&self) -> f64 {
+        self.part_mass.iter().map(|p| p.physical).sum()
+    }
+    /// Total added mass (kg).
+    pub fn added_mass(&self) -> f64 {
+        self.part_mass.iter().map(|p| p.added).sum()
+    }
+    /// Global element id of a slot.
+    pub fn slot_element(&self, slot: usize) -> u32 {
+        for g in &self.groups {
+            if slot >= g.slot_offset && slot < g.slot_offset + g.elements.len() {
+                return g.elements[slot - g.slot_offset];
+            }
+        }
+        u32::MAX
+    }
+}

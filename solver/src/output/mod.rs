@@ -1,0 +1,9 @@
+//! Output: ParaView-ready VTK XML unstructured grids with a `.pvd` time series, `history.csv`,
+//! and `.vtu` mesh reading. Every file is written atomically (temporary file in the same
+//! directory, then rename), so an interrupted run leaves only complete files.
+
+pub mod atomic;
+pub mod history;
+pub mod stress;
+pub mod vtk;
+pub mod vtu_read;

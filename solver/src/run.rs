@@ -1,0 +1,357 @@
+//! Drive a [`Scene`] to its end time: the time loop, VTK frames, `history.csv`, and the run
+//! summary. A stop request (Ctrl-C) ends the loop after the current step and leaves complete
+//! output up to the last frame; a failing run keeps what it had written and writes its
+//! summary with the error.
+
+use crate::output::history::History;
+use crate::output::stress::{principal, von_mises};
+use crate::output::vtk::{Frame, Series};
+use crate::scene::Scene;
+use crate::simulation::Simulation;
+use serde::Serialize;
+use std::path::Path;
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::time::Instant;
+
+/// Where the time went, per stage.
+#[derive(Clone, Debug, Serialize)]
+pub struct StageShare {
+    /// Stage name.
+    pub stage: String,
+    /// Seconds.
+    pub seconds: f64,
+    /// Share of the run's wall time.
+    pub share: f64,
+}
+
+/// Added mass of one part.
+#[derive(Clone, Debug, Serialize)]
+pub struct PartMassReport {
+    /// Part name.
+    pub part: String,
+    /// Physical mass (kg).
+    pub physical_kg: f64,
+    /// Added mass (kg).
+    pub added_kg: f64,
+    /// Added / physical, percent.
+    pub added_percent: f64,
+}
+
+/// The run summary, printed and written as `summary.json`.
+#[derive(Clone, Debug, Serialize)]
+pub struct RunSummary {
+    /// Scene title.
+    pub title: String,
+    /// How the run ended: `completed`, `converged`, `stopped` or the error.
+    pub status: String,
+    /// Simulated time reached (s).
+    pub time: f64,
+    /// Steps.
+    pub steps: u64,
+    /// Elements.
+    pub elements: usize,
+    /// Nodes.
+    pub nodes: usize,
+    /// Wall time (s).
+    pub wall_seconds: f64,
+    /// Element-cycles per second.
+    pub element_cycles_per_second: f64,
+    /// Smallest step (s).
+    pub dt_min: f64,
+    /// Largest step (s).
+    pub dt_max: f64,
+    /// Final energy error.
+    pub energy_error: f64,
+    /// Largest energy error over the run (after 1 % of the run).
+    pub max_energy_error: f64,
+    /// Final energies (J).
+    pub kinetic_energy: f64,
+    /// Final internal energy (J).
+    pub internal_energy: f64,
+    /// Final hourglass energy (J).
+    pub hourglass_energy: f64,
+    /// Final external work (J).
+    pub external_work: f64,
+    /// Active stages.
+    pub active_stages: Vec<String>,
+    /// Time per stage.
+    pub stage_times: Vec<StageShare>,
+    /// Mass per part.
+    pub mass: Vec<PartMassReport>,
+    /// Threads used.
+    pub threads: usize,
+    /// Frames written.
+    pub frames: usize,
+}
+
+/// Progress information for a progress bar.
+pub struct Progress<'a> {
+    /// The simulation.
+    pub sim: &'a Simulation,
+    /// End time (s).
+    pub end_time: f64,
+}
+
+/// History column names for a simulation.
+pub fn history_columns(sim: &Simulation, reactions: &[(String, Vec<u32>)]) -> Vec<String> {
+    let mut cols: Vec<String> = [
+        "time",
+        "dt",
+        "kinetic_energy",
+        "internal_energy",
+        "hourglass_energy",
+        "bulk_viscous_energy",
+        "damping_energy",
+        "contact_energy",
+        "external_work",
+        "law_dissipation",
+        "energy_error",
+    ]
+    .iter()
+    .map(|s| s.to_string())
+    .collect();
+    for (name, _) in reactions {
+        for d in ["x", "y", "z"] {
+            cols.push(format!("{name}_reaction_{d}"));
+        }
+    }
+    for st in &sim.stages {
+        cols.extend(st.history_columns());
+    }
+    cols
+}
+
+/// One history row.
+pub fn history_row(sim: &Simulation, reactions: &[(String, Vec<u32>)], row: &mut Vec<f64>) {
+    let e = &sim.energy;
+    row.clear();
+    row.extend([
+        sim.time,
+        sim.dt_prev,
+        e.kinetic,
+        e.internal,
+        e.hourglass,
+        e.bulk_viscous,
+        e.damping,
+        e.contact,
+        e.external,
+        e.law_dissipation,
+        e.error(),
+    ]);
+    for (_, nodes) in reactions {
+        let mut r = [0.0; 3];
+        for &n in nodes {
+            for d in 0..3 {
+                r[d] += sim.reaction[n as usize][d];
+            }
+        }
+        row.extend(r);
+    }
+    for st in &sim.stages {
+        st.history_values(row);
+    }
+}
+
+fn write_frame(scene: &Scene, series: &mut Series) -> Result<(), String> {
+    let sim = &scene.sim;
+    let plan = &scene.output;
+    let mut frame = Frame {
+        displacement: plan.has("displacement").then_some(&sim.u[..]),
+        velocity: plan.has("velocity").then_some(&sim.v[..]),
+        part: plan.has("part"),
+        stress: sim.stress.as_deref(),
+        tensor: plan.has("stress"),
+        ..Default::default()
+    };
+    if let Some(s) = &sim.stress {
+        if plan.has("von_mises") {
+            frame
+                .cell_scalars
+                .push(("von_mises".into(), s.iter().map(von_mises).collect()));
+        }
+        if plan.has("max_principal") {
+            frame.cell_scalars.push((
+                "max_principal_stress".into(),
+                s.iter().map(|x| principal(x)[0]).collect(),
+            ));
+        }
+    }
+    for st in &sim.stages {
+        frame.point_scalars.extend(st.point_fields());
+    }
+    series
+        .write(sim.time, &sim.model.mesh, &frame, &scene.title)
+        .map(|_| ())
+}
+
+/// Run a scene, writing into `out`. `observer` is called every few steps and may update a
+/// progress bar. Returns the summary (also on failure, with the error in `status`) and the
+/// error if the run failed.
+pub fn run_scene(
+    scene: &mut Scene,
+    out: &Path,
+    stop: &AtomicBool,
+    mut observer: impl FnMut(&Progress),
+) -> (RunSummary, Option<String>) {
+    let t_wall = Instant::now();
+    let mut error = None;
+    let mut status = "completed".to_string();
+    if let Err(e) = std::fs::create_dir_all(out) {
+        error = Some(format!(
+            "{}: cannot create the output directory: {e}",
+            out.display()
+        ));
+    }
+    let stem = "frame";
+    let mut series = Series::new(out, stem);
+    let reactions = scene.output.reactions.clone();
+    let mut history = History::new(
+        &out.join("history.csv"),
+        history_columns(&scene.sim, &reactions),
+    );
+    let mut row = Vec::new();
+    let end = scene.end_time;
+    let hist_dt = scene.output.history_interval.max(0.0);
+    let vtk_dt = scene.output.vtk_interval;
+    let mut next_hist = 0.0;
+    let mut next_vtk = 0.0;
+    let mut max_err: f64 = 0.0;
+    let mut last_flush = Instant::now();
+    if error.is_none() {
+        if let Err(e) = scene.sim.initialise() {
+            error = Some(e.to_string());
+        }
+    }
+    while error.is_none() {
+        let sim = &scene.sim;
+        let t = sim.time;
+        let done = t >= end * (1.0 - 1e-12);
+        if t >= next_hist || done {
+            history_row(sim, &reactions, &mut row);
+            history.push(&row);
+            next_hist += hist_dt;
+            while next_hist <= t && hist_dt > 0.0 {
+                next_hist += hist_dt;
+            }
+            if t > 0.01 * end {
+                max_err = max_err.max(sim.energy.error());
+            }
+        }
+        if let Some(vdt) = vtk_dt {
+            if t >= next_vtk * (1.0 - 1e-12) || done {
+                if let Err(e) = write_frame(scene, &mut series).and_then(|_| history.flush()) {
+                    error = Some(e);
+                    break;
+                }
+                last_flush = Instant::now();
+                next_vtk += vdt;
+                while next_vtk <= t && vdt > 0.0 {
+                    next_vtk += vdt;
+                }
+            }
+        }
+        if done {
+            break;
+        }
+        if let Some(r) = scene.sim.settings.relaxation {
+            if scene.sim.step > 10 && scene.sim.residual < r.tolerance {
+                status = "converged".into();
+                history_row(&scene.sim, &reactions, &mut row);
+                history.push(&row);
+                if vtk_dt.is_some() {
+                    let _ = write_frame(scene, &mut series);
+                }
+                break;
+            }
+        }
+        if stop.load(Ordering::Relaxed) {
+            status = "stopped".into();
+            break;
+        }
+        let stress_at = vtk_dt
+            .map(|_| next_vtk * (1.0 - 1e-12))
+            .unwrap_or(f64::INFINITY)
+            .min(end * (1.0 - 1e-12));
+        if let Err(e) = scene.sim.step(stress_at) {
+            error = Some(format!("{}: {e}", scene.path.display()));
+            break;
+        }
+        if scene.sim.step % 64 == 0 {
+            observer(&Progress {
+                sim: &scene.sim,
+                end_time: end,
+            });
+            if last_flush.elapsed().as_secs_f64() > 10.0 {
+                let _ = history.flush();
+                last_flush = Instant::now();
+            }
+        }
+    }
+    if let Err(e) = history.flush() {
+        error.get_or_insert(e);
+    }
+    if let Some(e) = &error {
+        status = format!("failed: {e}");
+    }
+    let sim = &scene.sim;
+    let wall = t_wall.elapsed().as_secs_f64();
+    let total_stage: f64 = sim.timers.iter().map(|s| s.time.as_secs_f64()).sum();
+    let mut stage_times: Vec<StageShare> = sim
+        .timers
+        .iter()
+        .filter(|s| !s.time.is_zero())
+        .map(|s| StageShare {
+            stage: s.name.to_string(),
+            seconds: s.time.as_secs_f64(),
+            share: s.time.as_secs_f64() / wall,
+        })
+        .collect();
+    stage_times.push(StageShare {
+        stage: "output and bookkeeping".into(),
+        seconds: (wall - total_stage).max(0.0),
+        share: (wall - total_stage).max(0.0) / wall,
+    });
+    let e = &sim.energy;
+    let summary = RunSummary {
+        title: scene.title.clone(),
+        status,
+        time: sim.time,
+        steps: sim.step,
+        elements: sim.model.mesh.elements.len(),
+        nodes: sim.model.mesh.nodes.len(),
+        wall_seconds: wall,
+        element_cycles_per_second: sim.model.mesh.elements.len() as f64 * sim.step as f64
+            / wall.max(1e-12),
+        dt_min: sim.dt_range.0,
+        dt_max: sim.dt_range.1,
+        energy_error: e.error(),
+        max_energy_error: max_err,
+        kinetic_energy: e.kinetic,
+        internal_energy: e.internal,
+        hourglass_energy: e.hourglass,
+        external_work: e.external,
+        active_stages: sim.active_stages(),
+        stage_times,
+        mass: sim
+            .model
+            .part_mass
+            .iter()
+            .map(|p| PartMassReport {
+                part: p.name.clone(),
+                physical_kg: p.physical,
+                added_kg: p.added,
+                added_percent: 100.0 * p.added / p.physical.max(1e-300),
+            })
+            .collect(),
+        threads: rayon::current_num_threads(),
+        frames: series.len(),
+    };
+    if let Ok(js) = serde_json::to_string_pretty(&summary) {
+        if let Err(e) =
+            crate::output::atomic::write_atomic(&out.join("summary.json"), js.as_bytes())
+        {
+            error.get_or_insert(e);
+        }
+    }
+    (summary, error)
+}

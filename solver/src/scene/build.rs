@@ -1,0 +1,564 @@
+//! Build a [`Scene`] (model, simulation, output plan) from a [`SceneSpec`].
+
+use super::spec::*;
+use crate::bc::{Constraint, Kinematic, NodalLoad};
+use crate::curve::Curve;
+use crate::element::{BulkViscosity, Formulation, Hourglass, HourglassForm};
+use crate::generate::{box_mesh, BoxSpec};
+use crate::mesh::Mesh;
+use crate::model::{MassScaling, Model, Part};
+use crate::simulation::{DynamicRelaxation, LoopSettings, Simulation};
+use material::Material;
+use std::path::{Path, PathBuf};
+
+/// What the output writer is asked for.
+#[derive(Clone, Debug)]
+pub struct OutputPlan {
+    /// Interval between VTK frames (s); None disables VTK output.
+    pub vtk_interval: Option<f64>,
+    /// Interval between history rows (s).
+    pub history_interval: f64,
+    /// Requested point and cell fields.
+    pub fields: Vec<String>,
+    /// Node sets whose reactions are written: (name, nodes).
+    pub reactions: Vec<(String, Vec<u32>)>,
+}
+
+impl OutputPlan {
+    /// Whether a field was requested.
+    pub fn has(&self, f: &str) -> bool {
+        self.fields.iter().any(|x| x == f)
+    }
+    /// Whether any stress-derived field was requested.
+    pub fn needs_stress(&self) -> bool {
+        self.has("stress") || self.has("von_mises") || self.has("max_principal")
+    }
+}
+
+/// A scene ready to run.
+pub struct Scene {
+    /// The simulation.
+    pub sim: Simulation,
+    /// End time (s).
+    pub end_time: f64,
+    /// Output plan.
+    pub output: OutputPlan,
+    /// Title.
+    pub title: String,
+    /// Source file.
+    pub path: PathBuf,
+}
+
+/// A scene error with its location.
+fn err(
+    path: &Path,
+    src: &str,
+    key: &str,
+    needle: Option<&str>,
+    msg: impl std::fmt::Display,
+) -> String {
+    let line = needle.and_then(|n| src.lines().position(|l| l.contains(n)).map(|i| i + 1));
+    match line {
+        Some(l) => format!("{}:{}: `{}`: {}", path.display(), l, key, msg),
+        None => format!("{}: `{}`: {}", path.display(), key, msg),
+    }
+}
+
+/// Read, parse and build a scene file.
+pub fn load_scene(path: &Path) -> Result<Scene, String> {
+    let src = std::fs::read_to_string(path)
+        .map_err(|e| format!("{}: cannot read the scene file: {e}", path.display()))?;
+    let spec: SceneSpec = toml::from_str(&src)
+        .map_err(|e| format!("{}: {}", path.display(), e.to_string().trim_end()))?;
+    build_scene(spec, path, &src)
+}
+
+fn axis(s: &str) -> Option<usize> {
+    match s {
+        "x" => Some(0),
+        "y" => Some(1),
+        "z" => Some(2),
+        _ => None,
+    }
+}
+
+/// Convert a curve spec, with values already in SI through their typed unit.
+pub fn curve<Q: Copy + Into<f64>>(c: &CurveSpec<Q>) -> Result<Curve, String> {
+    let cv = match c {
+        CurveSpec::Constant { value } => Curve::Constant((*value).into()),
+        CurveSpec::SmoothStep {
+            value,
+            from,
+            start,
+            end,
+        } => Curve::SmoothStep {
+            t0: start.map(|t| t.0).unwrap_or(0.0),
+            t1: end.0,
+            from: from.map(|f| f.into()).unwrap_or(0.0),
+            to: (*value).into(),
+        },
+        CurveSpec::Ramp { value, start, end } => {
+            let t0 = start.map(|t| t.0).unwrap_or(0.0);
+            Curve::Table(vec![(t0, 0.0), (end.0, (*value).into())])
+        }
+        CurveSpec::Table { time, value } => {
+            if time.len() != value.len() {
+                return Err(format!(
+                    "table has {} times but {} values",
+                    time.len(),
+                    value.len()
+                ));
+            }
+            Curve::Table(
+                time.iter()
+                    .zip(value)
+                    .map(|(t, v)| (t.0, (*v).into()))
+                    .collect(),
+            )
+        }
+    };
+    cv.validate()?;
+    Ok(cv)
+}
+
+fn read_mesh(spec: &MeshSpec, scene: &Path, src: &str) -> Result<Mesh, String> {
+    match (&spec.generator, &spec.file) {
+        (Some(g), None) if g == "box" => {
+            let size = spec
+                .size
+                .ok_or_else(|| err(scene, src, "mesh.size", None, "a box needs `size`"))?;
+            let divisions = spec.divisions.ok_or_else(|| {
+                err(
+                    scene,
+                    src,
+                    "mesh.divisions",
+                    None,
+                    "a box needs `divisions`",
+                )
+            })?;
+            let b = BoxSpec {
+                origin: spec
+                    .origin
+                    .map(|o| [o[0].0, o[1].0, o[2].0])
+                    .unwrap_or([0.0; 3]),
+                size: [size[0].0, size[1].0, size[2].0],
+                divisions,
+                grading: spec.grading.unwrap_or([1.0; 3]),
+                distortion: spec.distortion.unwrap_or(0.0),
+                seed: spec.seed.unwrap_or(1),
+            };
+            box_mesh(&b, spec.part.as_deref().unwrap_or("body"))
+                .map_err(|e| err(scene, src, "mesh", Some("[mesh]"), e))
+        }
+        (Some(g), None) => Err(err(
+            scene,
+            src,
+            "mesh.generator",
+            Some("generator"),
+            format!("unknown generator `{g}` (known: box)"),
+        )),
+        (None, Some(f)) => {
+            let p = scene.parent().unwrap_or(Path::new(".")).join(f);
+            crate::output::vtu_read::read_vtu_mesh(&p)
+                .map_err(|e| err(scene, src, "mesh.file", Some("file"), e))
+        }
+        _ => Err(err(
+            scene,
+            src,
+            "mesh",
+            Some("[mesh]"),
+            "give either `generator = \"box\"` or `file = \"mesh.vtu\"`",
+        )),
+    }
+}
+
+fn formulation(p: &PartSpec) -> Result<Formulation, String> {
+    let q = p.hourglass_coefficient.map(|x| x.0).unwrap_or(0.1);
+    if !(0.0..=1.0).contains(&q) {
+        return Err(format!("hourglass_coefficient must lie in [0, 1], got {q}"));
+    }
+    let form = match p.hourglass.as_deref() {
+        None | Some("viscous") => HourglassForm::Viscous,
+        Some("stiffness") => HourglassForm::Stiffness,
+        Some(o) => {
+            return Err(format!(
+                "hourglass must be `viscous` or `stiffness`, got `{o}`"
+            ))
+        }
+    };
+    Ok(match p.formulation.as_deref() {
+        None | Some("one_point") => Formulation::OnePoint(Hourglass {
+            form,
+            coefficient: q,
+        }),
+        Some("full_fbar") | Some("full") if p.hourglass.is_some() => {
+            return Err("hourglass control applies to one_point elements only".into())
+        }
+        Some("full_fbar") => Formulation::Full { fbar: true },
+        Some("full") => Formulation::Full { fbar: false },
+        Some(o) => {
+            return Err(format!(
+                "formulation must be `one_point`, `full_fbar` or `full`, got `{o}`"
+            ))
+        }
+    })
+}
+
+/// Build a scene from its parsed spec. `path` and `src` are used for error messages and to
+/// resolve relative file names.
+pub fn build_scene(spec: SceneSpec, path: &Path, src: &str) -> Result<Scene, String> {
+    let e = |key: &str, needle: Option<&str>, msg: &dyn std::fmt::Display| {
+        err(path, src, key, needle, msg)
+    };
+    let end_time = spec.run.end_time.0;
+    if !(end_time > 0.0) {
+        return Err(e("run.end_time", Some("end_time"), &"must be positive"));
+    }
+    let dt_factor = spec.run.dt_factor.map(|x| x.0).unwrap_or(0.9);
+    if !(dt_factor > 0.0 && dt_factor <= 1.0) {
+        return Err(e(
+            "run.dt_factor",
+            Some("dt_factor"),
+            &format!("must lie in (0, 1], got {dt_factor}"),
+        ));
+    }
+    let mut mesh = read_mesh(&spec.mesh, path, src)?;
+    // Node sets.
+    for (name, ns) in &spec.node_sets {
+        let key = format!("node_sets.{name}");
+        let mut nodes: Vec<u32> = Vec::new();
+        let mut given = 0;
+        if let (Some(lo), Some(hi)) = (ns.box_min, ns.box_max) {
+            nodes.extend(
+                mesh.nodes_in_box([lo[0].0, lo[1].0, lo[2].0], [hi[0].0, hi[1].0, hi[2].0]),
+            );
+            given += 1;
+        }
+        if let (Some(ax), Some(val)) = (&ns.plane_axis, ns.plane_value) {
+            let a = axis(ax)
+                .ok_or_else(|| e(&key, Some("plane_axis"), &"plane_axis must be x, y or z"))?;
+            nodes.extend(mesh.nodes_on_plane(a, val.0, ns.tolerance.map(|t| t.0).unwrap_or(1e-9)));
+            given += 1;
+        }
+        if let Some(ids) = &ns.nodes {
+            if let Some(bad) = ids.iter().find(|&&n| n as usize >= mesh.nodes.len()) {
+                return Err(e(
+                    &key,
+                    Some(&format!("[node_sets.{name}]")),
+                    &format!("node {bad} does not exist"),
+                ));
+            }
+            nodes.extend(ids);
+            given += 1;
+        }
+        if given != 1 {
+            return Err(e(
+                &key,
+                Some(&format!("[node_sets.{name}]")),
+                &"give exactly one of box_min+box_max, plane_axis+plane_value, nodes",
+            ));
+        }
+        nodes.sort_unstable();
+        nodes.dedup();
+        if nodes.is_empty() {
+            return Err(e(
+                &key,
+                Some(&format!("[node_sets.{name}]")),
+                &"selects no node",
+            ));
+        }
+        mesh.node_sets.insert(name.clone(), nodes);
+    }
+    let all: Vec<u32> = (0..mesh.nodes.len() as u32).collect();
+    let set = |name: &str, key: &str| -> Result<Vec<u32>, String> {
+        if name == "all" {
+            return Ok(all.clone());
+        }
+        mesh.node_sets.get(name).cloned().ok_or_else(|| {
+            let known: Vec<&String> = mesh.node_sets.keys().collect();
+            e(
+                key,
+                Some(&format!("\"{name}\"")),
+                &format!("no node set `{name}`; known: all, {known:?}"),
+            )
+        })
+    };
+    // Materials and parts.
+    let mut parts = Vec::new();
+    if spec.parts.is_empty() {
+        return Err(e("part", None, &"the scene defines no [[part]]"));
+    }
+    for pname in &mesh.part_names {
+        let ps = spec
+            .parts
+            .iter()
+            .find(|p| &p.name == pname)
+            .ok_or_else(|| {
+                e(
+                    "part",
+                    None,
+                    &format!("the mesh has a part `{pname}` but no [[part]] gives it a material"),
+                )
+            })?;
+        let key = format!("part `{pname}`");
+        let base = path.parent();
+        let material: Material = match spec.materials.get(&ps.material) {
+            Some(card) => card.build_in(&ps.material, base).map_err(|m| {
+                e(
+                    &format!("materials.{}", ps.material),
+                    Some(&format!("[materials.{}]", ps.material)),
+                    &m,
+                )
+            })?,
+            None if material::library::is_library_name(&ps.material) => {
+                material::library::named(&ps.material)
+                    .and_then(|c| c.build_in(&ps.material, base))
+                    .map_err(|m| e(&format!("{key}.material"), Some(&ps.material), &m))?
+            }
+            None => {
+                let known: Vec<&String> = spec.materials.keys().collect();
+                return Err(e(
+                    &format!("{key}.material"),
+                    Some(&format!("\"{}\"", ps.material)),
+                    &format!(
+                        "no material `{}`; known: {known:?} or a library name such as paper:liver",
+                        ps.material
+                    ),
+                ));
+            }
+        };
+        let formulation =
+            formulation(ps).map_err(|m| e(&key, Some(&format!("\"{pname}\"")), &m))?;
+        parts.push(Part {
+            name: pname.clone(),
+            material,
+            formulation,
+        });
+    }
+    for ps in &spec.parts {
+        if !mesh.part_names.contains(&ps.name) {
+            return Err(e(
+                "part.name",
+                Some(&format!("\"{}\"", ps.name)),
+                &format!(
+                    "the mesh has no part `{}`; its parts: {:?}",
+                    ps.name, mesh.part_names
+                ),
+            ));
+        }
+    }
+    // Boundary conditions.
+    let mut constraints = Vec::new();
+    for (i, b) in spec.boundaries.iter().enumerate() {
+        let key = format!("boundary[{i}]");
+        let nodes = set(&b.nodes, &format!("{key}.nodes"))?;
+        let mut fixed = [false; 3];
+        if let Some(f) = &b.fix {
+            for d in f {
+                if d == "all" {
+                    fixed = [true; 3];
+                } else {
+                    let a = axis(d).ok_or_else(|| {
+                        e(
+                            &format!("{key}.fix"),
+                            Some("fix"),
+                            &format!("`{d}` is not x, y, z or all"),
+                        )
+                    })?;
+                    fixed[a] = true;
+                }
+            }
+        }
+        if let Some(s) = &b.symmetry {
+            let a = axis(s).ok_or_else(|| {
+                e(
+                    &format!("{key}.symmetry"),
+                    Some("symmetry"),
+                    &format!("`{s}` is not x, y or z"),
+                )
+            })?;
+            fixed[a] = true;
+        }
+        for (a, f) in fixed.iter().enumerate() {
+            if *f {
+                constraints.push(Constraint {
+                    nodes: nodes.clone(),
+                    dof: a,
+                    kind: Kinematic::Fixed,
+                });
+            }
+        }
+        if let Some(d) = &b.displacement {
+            for (a, c) in [&d.x, &d.y, &d.z].into_iter().enumerate() {
+                if let Some(c) = c {
+                    let cv = curve(c)
+                        .map_err(|m| e(&format!("{key}.displacement"), Some("displacement"), &m))?;
+                    constraints.push(Constraint {
+                        nodes: nodes.clone(),
+                        dof: a,
+                        kind: Kinematic::Displacement(cv),
+                    });
+                }
+            }
+        }
+        if let Some(d) = &b.velocity {
+            for (a, c) in [&d.x, &d.y, &d.z].into_iter().enumerate() {
+                if let Some(c) = c {
+                    let cv = curve(c)
+                        .map_err(|m| e(&format!("{key}.velocity"), Some("velocity"), &m))?;
+                    constraints.push(Constraint {
+                        nodes: nodes.clone(),
+                        dof: a,
+                        kind: Kinematic::Velocity(cv),
+                    });
+                }
+            }
+        }
+    }
+    let mut loads = Vec::new();
+    for (i, l) in spec.loads.iter().enumerate() {
+        let key = format!("load[{i}]");
+        let nodes = set(&l.nodes, &format!("{key}.nodes"))?;
+        let share = if l.total.unwrap_or(false) {
+            1.0 / nodes.len() as f64
+        } else {
+            1.0
+        };
+        for (a, c) in [&l.force.x, &l.force.y, &l.force.z].into_iter().enumerate() {
+            if let Some(c) = c {
+                let mut cv = curve(c).map_err(|m| e(&format!("{key}.force"), Some("force"), &m))?;
+                scale_curve(&mut cv, share);
+                loads.push(NodalLoad {
+                    nodes: nodes.clone(),
+                    dof: a,
+                    curve: cv,
+                });
+            }
+        }
+    }
+    let mut v0: Option<Vec<[f64; 3]>> = None;
+    for (i, iv) in spec.initial_velocities.iter().enumerate() {
+        let nodes = set(&iv.nodes, &format!("initial_velocity[{i}].nodes"))?;
+        let v = v0.get_or_insert_with(|| vec![[0.0; 3]; mesh.nodes.len()]);
+        for n in nodes {
+            v[n as usize] = [iv.velocity[0].0, iv.velocity[1].0, iv.velocity[2].0];
+        }
+    }
+    // Output plan.
+    let out = &spec.output;
+    let known = [
+        "displacement",
+        "velocity",
+        "part",
+        "stress",
+        "von_mises",
+        "max_principal",
+        "history",
+    ];
+    let fields = out.fields.clone().unwrap_or_else(|| {
+        vec![
+            "displacement".into(),
+            "velocity".into(),
+            "part".into(),
+            "von_mises".into(),
+        ]
+    });
+    for f in &fields {
+        if !known.contains(&f.as_str()) {
+            return Err(e(
+                "output.fields",
+                Some(&format!("\"{f}\"")),
+                &format!("unknown field `{f}`; known: {known:?}"),
+            ));
+        }
+    }
+    let mut reactions = Vec::new();
+    for r in out.reactions.clone().unwrap_or_default() {
+        let nodes = set(&r, "output.reactions")?;
+        reactions.push((r, nodes));
+    }
+    let vtk_interval = if out.vtk == Some(false) {
+        None
+    } else {
+        Some(out.interval.map(|t| t.0).unwrap_or(end_time / 10.0))
+    };
+    let history_interval = out
+        .history_interval
+        .map(|t| t.0)
+        .unwrap_or(end_time / 500.0);
+    let plan = OutputPlan {
+        vtk_interval,
+        history_interval,
+        fields,
+        reactions,
+    };
+    // Settings.
+    let bulk = match &spec.bulk_viscosity {
+        Some(b) if b.enabled == Some(false) => None,
+        Some(b) => Some(BulkViscosity {
+            quadratic: b.quadratic.map(|x| x.0).unwrap_or(1.5),
+            linear: b.linear.map(|x| x.0).unwrap_or(0.06),
+        }),
+        None => Some(BulkViscosity::default()),
+    };
+    let mass_scaling = spec.mass_scaling.as_ref().map(|m| MassScaling {
+        target_dt: m.target_dt.0,
+        max_added: m.max_added.map(|x| x.0).unwrap_or(0.05),
+    });
+    let damping = spec
+        .damping
+        .as_ref()
+        .map(|d| d.mass_proportional.0)
+        .filter(|&a| a != 0.0);
+    let gravity = spec
+        .gravity
+        .as_ref()
+        .map(|g| {
+            [
+                g.acceleration[0].0,
+                g.acceleration[1].0,
+                g.acceleration[2].0,
+            ]
+        })
+        .filter(|g| g.iter().any(|&x| x != 0.0));
+    let relaxation = spec.relaxation.as_ref().map(|r| DynamicRelaxation {
+        tolerance: r.tolerance.map(|x| x.0).unwrap_or(1e-10),
+    });
+    let model = Model::build(mesh, parts, mass_scaling, dt_factor)
+        .map_err(|m| format!("{}: {m}", path.display()))?;
+    let dt0 = model.scaled_dt.min(model.initial_dt.0);
+    let settings = LoopSettings {
+        dt_factor,
+        bulk,
+        damping,
+        gravity,
+        relaxation,
+        dt_max: spec.run.dt_max.map(|t| t.0).unwrap_or(f64::INFINITY),
+        dt_min: spec.run.dt_min.map(|t| t.0).unwrap_or(1e-6 * dt0),
+    };
+    let want_stress = plan.needs_stress();
+    let sim = Simulation::new(model, settings, constraints, loads, v0, want_stress)
+        .map_err(|m| format!("{}: {m}", path.display()))?;
+    Ok(Scene {
+        sim,
+        end_time,
+        output: plan,
+        title: spec.run.title.clone().unwrap_or_else(|| {
+            path.file_stem()
+                .map(|s| s.to_string_lossy().into_owned())
+                .unwrap_or_default()
+        }),
+        path: path.to_path_buf(),
+    })
+}
+
+fn scale_curve(c: &mut Curve, s: f64) {
+    match c {
+        Curve::Constant(v) => *v *= s,
+        Curve::Table(p) => p.iter_mut().for_each(|x| x.1 *= s),
+        Curve::SmoothStep { from, to, .. } => {
+            *from *= s;
+            *to *= s;
+        }
+    }
+}

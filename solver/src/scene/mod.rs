@@ -1,0 +1,11 @@
+//! Scenes: the TOML file a user writes, and its translation into a runnable [`Simulation`].
+//!
+//! Errors name the file, and where possible the line and key: toml reports the line and key of
+//! a syntax error, an unknown key or a wrong unit; checks after parsing (an unknown node set, an
+//! unknown material) name the key path and the line where its value appears.
+
+pub mod build;
+pub mod spec;
+
+pub use build::{load_scene, Scene};
+pub use spec::SceneSpec;

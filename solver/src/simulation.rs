@@ -1,0 +1,599 @@
+//! The central-difference time loop (Belytschko, Liu, Moran, Nonlinear Finite Elements for
+//! Continua and Structures, Box 6.1), on lumped masses:
+//!
+//!   f_int^n = f_int(u^n, v^(n-1/2))            element loop, also gives dt_crit
+//!   a^n = M^-1 (f_ext^n - f_int^n - f_damp^n)
+//!   v^(n+1/2) = v^(n-1/2) + (dt^(n-1/2) + dt^(n+1/2))/2 a^n,   then kinematic conditions
+//!   u^(n+1) = u^n + dt^(n+1/2) v^(n+1/2)
+//!   dt^(n+3/2) = factor * dt_crit(u^(n+1))
+//!
+//! Energy balance (Belytschko et al. eq. 6.2.14-6.2.17), with the trapezoidal rule on nodal
+//! forces: W^n = W^(n-1) + (Delta u^(n-1/2) + Delta u^(n+1/2))/2 . f^n for the internal, external
+//! (loads, gravity, constraint reactions) and damping forces, split so that each value refers
+//! to time t^n. Kinetic energy at t^n uses v^n = (v^(n-1/2) + v^(n+1/2))/2. The internal work
+//! includes the hourglass and bulk-viscous forces; the hourglass energy (stored for the
+//! stiffness form, dissipated for the viscous form) and the bulk-viscous dissipation are
+//! accumulated from element-level rates and reported separately, and
+//!   internal_energy = W_int - E_hourglass - E_bulk.
+//! energy_error = |E_kin + E_int + E_dissipated - W_ext| / max(E_kin, E_int, W_ext).
+//!
+//! Only the stages the scene asks for exist: damping, gravity, loads, contact and dynamic
+//! relaxation are `Option`s decided at construction.
+
+use crate::bc::{Constraint, Kinematic, NodalLoad};
+use crate::element::{BulkViscosity, StepInput};
+use crate::forces::{element_loop, gather, ElementTotals};
+use crate::model::{Model, SolverError};
+use std::time::{Duration, Instant};
+
+/// Energies at the current time (J).
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Energies {
+    /// Kinetic energy.
+    pub kinetic: f64,
+    /// Internal (stress) work, including the laws' dissipated part.
+    pub internal: f64,
+    /// Hourglass energy.
+    pub hourglass: f64,
+    /// Bulk-viscous dissipation.
+    pub bulk_viscous: f64,
+    /// Damping dissipation.
+    pub damping: f64,
+    /// Contact work (penalty energy) absorbed between body and indenters.
+    pub contact: f64,
+    /// External work: loads, gravity, constraint reactions, contact forces.
+    pub external: f64,
+    /// Dissipated by the laws (part of `internal`).
+    pub law_dissipation: f64,
+}
+
+impl Energies {
+    /// The normalised energy error.
+    pub fn error(&self) -> f64 {
+        let bal = self.kinetic
+            + self.internal
+            + self.hourglass
+            + self.bulk_viscous
+            + self.damping
+            + self.contact
+            - self.external;
+        let scale = self
+            .kinetic
+            .abs()
+            .max(self.internal.abs())
+            .max(self.external.abs());
+        if scale > 0.0 {
+            bal.abs() / scale
+        } else {
+            0.0
+        }
+    }
+}
+
+/// Kinetic damping for quasi-static solutions (dynamic relaxation).
+#[derive(Clone, Copy, Debug)]
+pub struct DynamicRelaxation {
+    /// Converged when the out-of-balance force norm falls below tol times the internal force norm.
+    pub tolerance: f64,
+}
+
+/// A named stage with its accumulated wall time.
+#[derive(Clone, Debug)]
+pub struct StageTime {
+    /// Stage name.
+    pub name: &'static str,
+    /// Wall time spent.
+    pub time: Duration,
+}
+
+/// An external-force stage (contact): adds forces to `f_ext` given current positions.
+pub trait ForceStage: Send {
+    /// Name for the run summary.
+    fn name(&self) -> &'static str;
+    /// Add forces at time `t` for current positions `x` and velocities `v` (at the last half
+    /// step) to `force`; `dt` is the step about to be taken.
+    fn apply(&mut self, t: f64, dt: f64, x: &[[f64; 3]], v: &[[f64; 3]], force: &mut [[f64; 3]]);
+    /// Energy the stage has absorbed (J) (stored penalty energy plus dissipation).
+    fn energy(&self) -> f64;
+    /// Largest time step the stage allows (s).
+    fn max_dt(&self) -> f64 {
+        f64::INFINITY
+    }
+    /// Extra history columns.
+    fn history_columns(&self) -> Vec<String> {
+        Vec::new()
+    }
+    /// Values of the extra history columns, appended to `out`.
+    fn history_values(&self, _out: &mut Vec<f64>) {}
+    /// Per-node scalars for VTK output (name, values).
+    fn point_fields(&self) -> Vec<(String, Vec<f64>)> {
+        Vec::new()
+    }
+}
+
+/// Settings of the time loop.
+#[derive(Clone, Debug)]
+pub struct LoopSettings {
+    /// Time-step safety factor (default 0.9).
+    pub dt_factor: f64,
+    /// Bulk viscosity, if active.
+    pub bulk: Option<BulkViscosity>,
+    /// Mass-proportional damping coefficient alpha (1/s), f = alpha m v.
+    pub damping: Option<f64>,
+    /// Gravity (m/s^2).
+    pub gravity: Option<[f64; 3]>,
+    /// Dynamic relaxation.
+    pub relaxation: Option<DynamicRelaxation>,
+    /// Largest allowed step (s).
+    pub dt_max: f64,
+    /// Smallest allowed step before the run is stopped (s).
+    pub dt_min: f64,
+}
+
+impl Default for LoopSettings {
+    fn default() -> Self {
+        LoopSettings {
+            dt_factor: 0.9,
+            bulk: Some(BulkViscosity::default()),
+            damping: None,
+            gravity: None,
+            relaxation: None,
+            dt_max: f64::INFINITY,
+            dt_min: 0.0,
+        }
+    }
+}
+
+/// Prescribed degree of freedom.
+#[derive(Clone, Debug)]
+struct Prescribed {
+    kind: Kinematic,
+}
+
+/// The running simulation.
+pub struct Simulation {
+    /// The model.
+    pub model: Model,
+    /// Settings.
+    pub settings: LoopSettings,
+    /// Displacements u^n (m).
+    pub u: Vec<[f64; 3]>,
+    /// Velocities v^(n-1/2) (m/s).
+    pub v: Vec<[f64; 3]>,
+    /// Internal forces f_int^n (N).
+    pub f_int: Vec<[f64; 3]>,
+    /// External forces f_ext^n (N): loads, gravity, contact.
+    pub f_ext: Vec<[f64; 3]>,
+    /// Constraint reactions R^n (N), on constrained dofs.
+    pub reaction: Vec<[f64; 3]>,
+    /// Cauchy stress per element at the last output step (Pa), if requested.
+    pub stress: Option<Vec<[f64; 6]>>,
+    slots: Vec<[[f64; 3]; 8]>,
+    dof_code: Vec<u32>,
+    prescribed: Vec<Prescribed>,
+    loads: Vec<NodalLoad>,
+    gravity_force: Option<Vec<[f64; 3]>>,
+    /// External force stages (contact).
+    pub stages: Vec<Box<dyn ForceStage>>,
+    /// Time t^n (s).
+    pub time: f64,
+    /// Steps taken.
+    pub step: u64,
+    /// Step dt^(n-1/2) (s).
+    pub dt_prev: f64,
+    /// Critical step of the last element loop (s), times the factor.
+    pub dt_next: f64,
+    /// Element that controls the step.
+    pub dt_element: u32,
+    /// Smallest and largest step taken (s).
+    pub dt_range: (f64, f64),
+    /// Energies at t^n.
+    pub energy: Energies,
+    w_int_acc: f64,
+    w_ext_acc: f64,
+    w_damp_acc: f64,
+    ke_half_prev: f64,
+    /// Out-of-balance force norm / internal force norm at the last step (relaxation).
+    pub residual: f64,
+    /// Stage timers.
+    pub timers: Vec<StageTime>,
+    totals: ElementTotals,
+    initialised: bool,
+    hg_dissipated: f64,
+    scratch_x: Vec<[f64; 3]>,
+    scratch_targets: Vec<f64>,
+}
+
+const T_ELEMENTS: usize = 0;
+const T_GATHER: usize = 1;
+const T_LOADS: usize = 2;
+const T_CONTACT: usize = 3;
+const T_UPDATE: usize = 4;
+
+impl Simulation {
+    /// Set up a simulation. Initial velocities may be given per node.
+    pub fn new(
+        model: Model,
+        settings: LoopSettings,
+        constraints: Vec<Constraint>,
+        loads: Vec<NodalLoad>,
+        initial_velocity: Option<Vec<[f64; 3]>>,
+        want_stress: bool,
+    ) -> Result<Simulation, SolverError> {
+        let nn = model.mesh.nodes.len();
+        let mut dof_code = vec![0u32; nn * 3];
+        let mut prescribed = Vec::new();
+        for c in &constraints {
+            if c.dof > 2 {
+                return Err(SolverError::Invalid(
+                    "constraint direction must be x, y or z".into(),
+                ));
+            }
+            let code = match &c.kind {
+                Kinematic::Fixed => 1,
+                k => {
+                    prescribed.push(Prescribed { kind: k.clone() });
+                    (prescribed.len() + 1) as u32
+                }
+            };
+            for &n in &c.nodes {
+                if n as usize >= nn {
+                    return Err(SolverError::Invalid(format!(
+                        "constraint refers to node {n} beyond the mesh"
+                    )));
+                }
+                dof_code[n as usize * 3 + c.dof] = code;
+            }
+        }
+        for l in &loads {
+            if let Some(&n) = l.nodes.iter().find(|&&n| n as usize >= nn) {
+                return Err(SolverError::Invalid(format!(
+                    "load refers to node {n} beyond the mesh"
+                )));
+            }
+        }
+        let gravity_force = settings.gravity.map(|g| {
+            model
+                .mass
+                .iter()
+                .map(|&m| [m * g[0], m * g[1], m * g[2]])
+                .collect()
+        });
+        let n_slots = model.n_slots;
+        let ne = model.mesh.elements.len();
+        let mut v = initial_velocity.unwrap_or_else(|| vec![[0.0; 3]; nn]);
+        if v.len() != nn {
+            return Err(SolverError::Invalid(
+                "initial velocity has the wrong length".into(),
+            ));
+        }
+        for n in 0..nn {
+            for d in 0..3 {
+                if dof_code[n * 3 + d] == 1 {
+                    v[n][d] = 0.0;
+                }
+            }
+        }
+        let timers = ["element forces", "assembly", "loads", "contact", "update"]
+            .into_iter()
+            .map(|name| StageTime {
+                name,
+                time: Duration::ZERO,
+            })
+            .collect();
+        Ok(Simulation {
+            model,
+            settings,
+            u: vec![[0.0; 3]; nn],
+            v,
+            f_int: vec![[0.0; 3]; nn],
+            f_ext: vec![[0.0; 3]; nn],
+            reaction: vec![[0.0; 3]; nn],
+            stress: if want_stress {
+                Some(vec![[0.0; 6]; ne])
+            } else {
+                None
+            },
+            slots: vec![[[0.0; 3]; 8]; n_slots],
+            dof_code,
+            prescribed,
+            loads,
+            gravity_force,
+            stages: Vec::new(),
+            time: 0.0,
+            step: 0,
+            dt_prev: 0.0,
+            dt_next: 0.0,
+            dt_element: 0,
+            dt_range: (f64::INFINITY, 0.0),
+            energy: Energies::default(),
+            w_int_acc: 0.0,
+            w_ext_acc: 0.0,
+            w_damp_acc: 0.0,
+            ke_half_prev: 0.0,
+            residual: f64::INFINITY,
+            timers,
+            totals: ElementTotals::default(),
+            initialised: false,
+            hg_dissipated: 0.0,
+            scratch_x: vec![[0.0; 3]; nn],
+            scratch_targets: Vec::new(),
+        })
+    }
+
+    /// Names of the stages that exist in this run.
+    pub fn active_stages(&self) -> Vec<String> {
+        let mut s = vec![
+            "element forces".to_string(),
+            "assembly".into(),
+            "central-difference update".into(),
+        ];
+        if self.settings.bulk.is_some() {
+            s.push("bulk viscosity".into());
+        }
+        if self.model.groups.iter().any(|g| !g.history.is_empty()) {
+            s.push("history variables".into());
+        }
+        if self
+            .model
+            .groups
+            .iter()
+            .any(|g| !g.density_scale.is_empty())
+        {
+            s.push("mass scaling".into());
+        }
+        if self.settings.damping.is_some() {
+            s.push("mass-proportional damping".into());
+        }
+        if self.gravity_force.is_some() {
+            s.push("gravity".into());
+        }
+        if !self.loads.is_empty() {
+            s.push("nodal loads".into());
+        }
+        if !self.prescribed.is_empty() {
+            s.push("prescribed motion".into());
+        }
+        for st in &self.stages {
+            s.push(st.name().to_string());
+        }
+        if self.settings.relaxation.is_some() {
+            s.push("dynamic relaxation".into());
+        }
+        s
+    }
+
+    fn time_stage<R>(&mut self, k: usize, f: impl FnOnce(&mut Self) -> R) -> R {
+        let t0 = Instant::now();
+        let r = f(self);
+        self.timers[k].time += t0.elapsed();
+        r
+    }
+
+    /// Compute internal forces at the current state. `want_stress` also fills `self.stress`.
+    fn internal_forces(&mut self, want_stress: bool) -> Result<(), SolverError> {
+        let input = StepInput {
+            dt: self.dt_prev,
+            bulk: self.settings.bulk,
+            want_stress,
+        };
+        let t0 = Instant::now();
+        let stress = if want_stress {
+            self.stress.as_deref_mut()
+        } else {
+            None
+        };
+        let Model {
+            parts,
+            groups,
+            mesh,
+            ..
+        } = &mut self.model;
+        let r = element_loop(
+            parts,
+            groups,
+            &mesh.nodes,
+            &self.u,
+            &self.v,
+            &input,
+            &mut self.slots,
+            stress,
+        );
+        self.timers[T_ELEMENTS].time += t0.elapsed();
+        let tot = r.map_err(|(e, reason)| SolverError::ElementFailure {
+            element: e,
+            part: self.part_of(e),
+            time: self.time,
+            reason,
+        })?;
+        self.totals = tot;
+        self.dt_next = self.settings.dt_factor * tot.dt_min;
+        self.dt_element = tot.dt_elem;
+        self.time_stage(T_GATHER, |s| gather(&s.model, &s.slots, &mut s.f_int));
+        Ok(())
+    }
+
+    /// Part name of an element.
+    pub fn part_of(&self, e: u32) -> String {
+        let p = self.model.mesh.element_part[e as usize] as usize;
+        self.model
+            .parts
+            .get(p)
+            .map(|p| p.name.clone())
+            .unwrap_or_default()
+    }
+
+    /// External forces at time t: loads, gravity, then the force stages (contact).
+    fn external_forces(&mut self) {
+        let t = self.time;
+        let t0 = Instant::now();
+        match &self.gravity_force {
+            Some(g) => self.f_ext.copy_from_slice(g),
+            None => self.f_ext.iter_mut().for_each(|f| *f = [0.0; 3]),
+        }
+        for l in &self.loads {
+            let val = l.curve.value(t);
+            for &n in &l.nodes {
+                self.f_ext[n as usize][l.dof] += val;
+            }
+        }
+        self.timers[T_LOADS].time += t0.elapsed();
+        if !self.stages.is_empty() {
+            let t0 = Instant::now();
+            let nodes = &self.model.mesh.nodes;
+            // Current positions are formed by each stage from reference + displacement.
+            let cur: &mut Vec<[f64; 3]> = &mut self.scratch_x;
+            for (c, (p, d)) in cur.iter_mut().zip(nodes.iter().zip(self.u.iter())) {
+                *c = [p[0] + d[0], p[1] + d[1], p[2] + d[2]];
+            }
+            let dt = self.dt_next;
+            for st in self.stages.iter_mut() {
+                st.apply(t, dt, cur, &self.v, &mut self.f_ext);
+            }
+            self.timers[T_CONTACT].time += t0.elapsed();
+        }
+    }
+
+    /// Compute the forces of the initial state (called by the first step if not before).
+    pub fn initialise(&mut self) -> Result<(), SolverError> {
+        if !self.initialised {
+            self.internal_forces(self.stress.is_some())?;
+            self.initialised = true;
+        }
+        Ok(())
+    }
+
+    /// Take one step from t^n to t^(n+1). If the new time reaches `stress_at` (s), the Cauchy
+    /// stress of the new state is stored in `self.stress` (when stress output was requested).
+    pub fn step(&mut self, stress_at: f64) -> Result<(), SolverError> {
+        self.initialise()?;
+        self.external_forces();
+        let mut dt = self.dt_next.min(self.settings.dt_max);
+        for st in &self.stages {
+            dt = dt.min(st.max_dt());
+        }
+        if !(dt > self.settings.dt_min) || !dt.is_finite() {
+            let e = self.dt_element;
+            return Err(SolverError::ElementFailure {
+                element: e,
+                part: self.part_of(e),
+                time: self.time,
+                reason: format!(
+                    "the stable time step fell to {dt:.3e} s (below the minimum {:.3e} s): the element is \
+                     collapsing or its wave speed exploded",
+                    self.settings.dt_min
+                ),
+            });
+        }
+        let t0 = Instant::now();
+        self.update(dt);
+        self.timers[T_UPDATE].time += t0.elapsed();
+        self.step += 1;
+        self.time += dt;
+        self.dt_prev = dt;
+        self.dt_range = (self.dt_range.0.min(dt), self.dt_range.1.max(dt));
+        // Forces at the new state, for the next step (and its stable dt).
+        let want = self.stress.is_some() && self.time >= stress_at;
+        self.internal_forces(want)
+    }
+
+    /// The nodal update with kinematic conditions and the energy sums.
+    fn update(&mut self, dt: f64) {
+        let dt_old = self.dt_prev;
+        let dt_avg = 0.5 * (dt_old + dt);
+        let t = self.time;
+        let alpha = self.settings.damping.unwrap_or(0.0);
+        let damping = self.settings.damping.is_some();
+        let relax = self.settings.relaxation.is_some();
+        // Kinematic targets evaluated once per prescription.
+        let targets: &mut Vec<f64> = &mut self.scratch_targets;
+        targets.clear();
+        for p in &self.prescribed {
+            targets.push(match &p.kind {
+                Kinematic::Velocity(c) => c.value(t + 0.5 * dt),
+                Kinematic::Displacement(c) => c.value(t + dt),
+                Kinematic::Fixed => 0.0,
+            });
+        }
+        let mut s = [0.0f64; 10];
+        // s: 0 w_int_old 1 w_int_new 2 w_ext_old 3 w_ext_new 4 w_damp_old 5 w_damp_new 6 ke 7 ke_half 8 res2 9 fint2
+        for n in 0..self.u.len() {
+            let m = self.model.mass[n];
+            for d in 0..3 {
+                let v_old = self.v[n][d];
+                let fi = self.f_int[n][d];
+                let fe = self.f_ext[n][d];
+                let fd = if damping { alpha * m * v_old } else { 0.0 };
+                let fnet = fe - fi - fd;
+                let code = self.dof_code[n * 3 + d];
+                let (v_new, r) = if code == 0 {
+                    (v_old + dt_avg * fnet / m, 0.0)
+                } else {
+                    let v_new = match code {
+                        1 => 0.0,
+                        k => {
+                            let tgt = targets[(k - 2) as usize];
+                            match self.prescribed[(k - 2) as usize].kind {
+                                Kinematic::Displacement(_) => (tgt - self.u[n][d]) / dt,
+                                _ => tgt,
+                            }
+                        }
+                    };
+                    (v_new, m * (v_new - v_old) / dt_avg - fnet)
+                };
+                self.reaction[n][d] = r;
+                if code == 0 {
+                    s[8] += fnet * fnet;
+                }
+                s[9] += fi * fi;
+                let h_old = 0.5 * dt_old * v_old;
+                let h_new = 0.5 * dt * v_new;
+                s[0] += fi * h_old;
+                s[1] += fi * h_new;
+                s[2] += (fe + r) * h_old;
+                s[3] += (fe + r) * h_new;
+                s[4] += fd * h_old;
+                s[5] += fd * h_new;
+                let vn = 0.5 * (v_old + v_new);
+                s[6] += 0.5 * m * vn * vn;
+                s[7] += 0.5 * m * v_new * v_new;
+                self.v[n][d] = v_new;
+                self.u[n][d] += dt * v_new;
+            }
+        }
+        // Energies at t^n.
+        let tot = self.totals;
+        let w_int = self.w_int_acc + s[0];
+        let w_ext = self.w_ext_acc + s[2];
+        let w_damp = self.w_damp_acc + s[4];
+        self.w_int_acc = w_int + s[1];
+        self.w_ext_acc = w_ext + s[3];
+        self.w_damp_acc = w_damp + s[5];
+        let e = &mut self.energy;
+        self.hg_dissipated += tot.hg_power * dt_avg;
+        e.hourglass = tot.hg_stored + self.hg_dissipated;
+        e.bulk_viscous += tot.bulk_power * dt_avg;
+        e.law_dissipation += tot.law_dissipation;
+        e.kinetic = s[6];
+        e.damping = w_damp;
+        // The indenters' work is the work of the contact forces on the body plus the energy the
+        // contact interface absorbed (penalty energy, friction).
+        e.contact = self.stages.iter().map(|s| s.energy()).sum();
+        e.external = w_ext + e.contact;
+        e.internal = w_int - e.hourglass - e.bulk_viscous;
+        self.residual = if s[9] > 0.0 {
+            (s[8] / s[9]).sqrt()
+        } else {
+            0.0
+        };
+        if relax {
+            // Kinetic damping: at a kinetic-energy peak, stop all motion.
+            if s[7] < self.ke_half_prev {
+                self.v.iter_mut().for_each(|v| *v = [0.0; 3]);
+                self.ke_half_prev = 0.0;
+            } else {
+                self.ke_half_prev = s[7];
+            }
+        }
+    }
+}

@@ -1,0 +1,88 @@
+//! `palpa check SCENE`: validate without running.
+
+use solver::hex::corner_jacobians;
+use solver::scene::load_scene;
+use std::path::Path;
+
+/// Validate a scene and report what a run would do.
+pub fn check(path: &Path) -> Result<(), String> {
+    let scene = load_scene(path)?;
+    let sim = &scene.sim;
+    let m = &sim.model;
+    let mesh = &m.mesh;
+    println!("scene {} is valid: `{}`", path.display(), scene.title);
+    println!(
+        "  mesh: {} nodes, {} elements, {} parts",
+        mesh.nodes.len(),
+        mesh.elements.len(),
+        m.parts.len()
+    );
+    let mut min_scaled = f64::INFINITY;
+    let mut worst = 0;
+    for (e, c) in mesh.elements.iter().enumerate() {
+        let x: [[f64; 3]; 8] = std::array::from_fn(|a| mesh.nodes[c[a] as usize]);
+        let (_, s) = corner_jacobians(&x);
+        let v = s.iter().cloned().fold(f64::INFINITY, f64::min);
+        if v < min_scaled {
+            min_scaled = v;
+            worst = e;
+        }
+    }
+    println!("  element quality: minimum scaled Jacobian {min_scaled:.4} (element {worst})");
+    for (p, pm) in m.parts.iter().zip(&m.part_mass) {
+        println!(
+            "  part {:<12} {:>8} elements, law {}, {}, mass {:.4e} kg",
+            p.name,
+            pm.elements,
+            p.material.law_name(),
+            p.formulation.label(),
+            pm.physical
+        );
+    }
+    let (dt0, e0) = m.initial_dt;
+    let f = sim.settings.dt_factor;
+    println!(
+        "  stable time step: {:.4e} s (factor {f} x {:.4e} s, element {e0})",
+        f * dt0,
+        dt0
+    );
+    if m.added_mass() > 0.0 {
+        println!(
+            "  mass scaling: step {:.4e} s, added {:.4e} kg = {:.3} % of {:.4e} kg",
+            f * m.scaled_dt,
+            m.added_mass(),
+            100.0 * m.added_mass() / m.physical_mass(),
+            m.physical_mass()
+        );
+    } else {
+        println!("  mass scaling: none");
+    }
+    let steps = scene.end_time / (f * m.scaled_dt.min(dt0).max(m.scaled_dt));
+    println!(
+        "  estimated steps: {:.0} ({:.3e} element-cycles) for end time {:.4} ms",
+        steps,
+        steps * mesh.elements.len() as f64,
+        scene.end_time * 1e3
+    );
+    let hist: usize = m.groups.iter().map(|g| g.history.len()).sum();
+    let ref_data: usize = m
+        .groups
+        .iter()
+        .map(|g| {
+            g.conn.len() * (8 * 4 + 24 * 8 + 8)
+                + g.gamma.len() * 32 * 8
+                + g.gp_grad.len() * 192 * 8
+                + g.gp_weight.len() * 64
+                + g.density_scale.len() * 8
+        })
+        .sum();
+    let nodal = mesh.nodes.len() * 8 * (3 * 7 + 1);
+    let bytes = ref_data + hist * 8 + nodal + m.n_slots * 24 * 8 + m.gather_idx.len() * 4;
+    println!(
+        "  memory estimate: {:.1} MiB (history {:.1} MiB)",
+        bytes as f64 / 1048576.0,
+        hist as f64 * 8.0 / 1048576.0
+    );
+    println!("  stages: {}", sim.active_stages().join(", "));
+    Ok(())
+}

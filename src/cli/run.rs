@@ -1,0 +1,94 @@
+//! `palpa run SCENE --out DIR`.
+
+use super::progress::{stop_flag, time_bar};
+use solver::run::{run_scene, RunSummary};
+use solver::scene::load_scene;
+use std::path::Path;
+use std::time::Instant;
+
+/// Print the run summary.
+pub fn print_summary(s: &RunSummary) {
+    println!("run `{}`: {}", s.title, s.status);
+    println!(
+        "  simulated {:.4} ms in {} steps, {:.2} s wall on {} thread(s): {:.3} M element-cycles/s",
+        s.time * 1e3,
+        s.steps,
+        s.wall_seconds,
+        s.threads,
+        s.element_cycles_per_second / 1e6
+    );
+    println!(
+        "  {} elements, {} nodes; dt {:.4e} .. {:.4e} s",
+        s.elements, s.nodes, s.dt_min, s.dt_max
+    );
+    println!(
+        "  energy: kinetic {:.4e} J, internal {:.4e} J, hourglass {:.4e} J, external work {:.4e} J; error {:.3} % (max {:.3} %)",
+        s.kinetic_energy,
+        s.internal_energy,
+        s.hourglass_energy,
+        s.external_work,
+        100.0 * s.energy_error,
+        100.0 * s.max_energy_error
+    );
+    println!("  active stages: {}", s.active_stages.join(", "));
+    println!("  where the time went:");
+    for st in &s.stage_times {
+        println!(
+            "    {:<24} {:>8.3} s  {:>5.1} %",
+            st.stage,
+            st.seconds,
+            100.0 * st.share
+        );
+    }
+    for m in &s.mass {
+        println!(
+            "  part {:<12} mass {:.4e} kg, added {:.4e} kg ({:.3} %)",
+            m.part, m.physical_kg, m.added_kg, m.added_percent
+        );
+    }
+}
+
+/// Run a scene file.
+pub fn run(scene_path: &Path, out: &Path, quiet: bool) -> Result<(), String> {
+    let t0 = Instant::now();
+    let mut scene = load_scene(scene_path)?;
+    if !quiet {
+        println!(
+            "scene {}: {} elements, {} nodes, built in {:.2} s",
+            scene_path.display(),
+            scene.sim.model.mesh.elements.len(),
+            scene.sim.model.mesh.nodes.len(),
+            t0.elapsed().as_secs_f64()
+        );
+        if scene.sim.model.added_mass() > 0.0 {
+            for m in &scene.sim.model.part_mass {
+                println!(
+                    "  mass scaling: part {} +{:.3} % ({} of {} elements scaled)",
+                    m.name,
+                    100.0 * m.added / m.physical,
+                    m.scaled_elements,
+                    m.elements
+                );
+            }
+        }
+    }
+    let stop = stop_flag();
+    let pb = time_bar(scene.end_time, quiet);
+    let wall = Instant::now();
+    let (summary, err) = run_scene(&mut scene, out, &stop, |p| {
+        pb.set_position((p.sim.time * 1e6) as u64);
+        let rate = p.sim.step as f64 / wall.elapsed().as_secs_f64().max(1e-9);
+        pb.set_message(format!(
+            "t = {:.3} ms, {:.0} steps/s",
+            p.sim.time * 1e3,
+            rate
+        ));
+    });
+    pb.finish_and_clear();
+    print_summary(&summary);
+    println!("  output: {}", out.display());
+    match err {
+        Some(e) => Err(e),
+        None => Ok(()),
+    }
+}
