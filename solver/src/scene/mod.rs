@@ -5,6 +5,7 @@
 //! unknown material) name the key path and the line where its value appears.
 
 pub mod build;
+pub mod contact_spec;
 pub mod spec;
 
 pub use build::{load_scene, Scene};

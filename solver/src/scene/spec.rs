@@ -46,6 +46,14 @@ pub struct SceneSpec {
     /// Output requests.
     #[serde(default)]
     pub output: OutputSpec,
+    /// Rigid indenters (`[[indenter]]`).
+    #[serde(default, rename = "indenter")]
+    pub indenters: Vec<super::contact_spec::IndenterScene>,
+    /// Two-finger hands (`[[hand]]`).
+    #[serde(default, rename = "hand")]
+    pub hands: Vec<super::contact_spec::HandScene>,
+    /// Contact settings (`[contact]`).
+    pub contact: Option<super::contact_spec::ContactScene>,
 }
 
 /// `[run]`.

@@ -1,0 +1,66 @@
+//! `scenes/compression-block.toml`: a neo-Hookean cube compressed 10 % on rollers is in
+//! homogeneous uniaxial stress. Closed form: lateral stretch l_t from S_22 = 0,
+//!   mu (1 - l_t^-2) + lambda ln J / l_t^2 = 0,  J = l_z l_t^2,
+//! and the nominal stress P_33 = l_z [mu (1 - l_z^-2) + lambda ln J / l_z^2]; the support
+//! reaction is -P_33 A0. Tolerances from issue 2: 0.5 % on the force, energy error < 1 %.
+
+mod common;
+use solver::output::history::column;
+use solver::scene::load_scene;
+use std::path::Path;
+
+fn closed_form(e: f64, nu: f64, lz: f64, area: f64) -> f64 {
+    let mu = e / (2.0 * (1.0 + nu));
+    let lam = e * nu / ((1.0 + nu) * (1.0 - 2.0 * nu));
+    let s22 = |lt: f64| mu * (1.0 - 1.0 / (lt * lt)) + lam * (lz * lt * lt).ln() / (lt * lt);
+    let mut lt = 1.0;
+    for _ in 0..60 {
+        let h = 1e-7;
+        lt -= s22(lt) / ((s22(lt + h) - s22(lt - h)) / (2.0 * h));
+    }
+    let j = lz * lt * lt;
+    let p33 = lz * (mu * (1.0 - 1.0 / (lz * lz)) + lam * j.ln() / (lz * lz));
+    -p33 * area
+}
+
+fn check(formulation: &str) {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes/compression-block.toml");
+    let src = std::fs::read_to_string(&path).unwrap();
+    let src = src.replace(
+        "formulation = \"one_point\"",
+        &format!("formulation = \"{formulation}\""),
+    );
+    let src = if formulation == "one_point" {
+        src
+    } else {
+        src.replace("hourglass = \"viscous\"", "")
+            .replace("hourglass_coefficient = 0.1", "")
+    };
+    let tmp = common::tmp_dir(&format!("cb-{formulation}"));
+    let scene_path = tmp.join("scene.toml");
+    std::fs::write(&scene_path, src).unwrap();
+    let mut scene = load_scene(&scene_path).unwrap();
+    let (cols, rows) = common::run_to_end(&mut scene, &format!("cb-run-{formulation}"));
+    let rz = column(&cols, &rows, "zmin_reaction_z").unwrap();
+    let err = column(&cols, &rows, "energy_error").unwrap();
+    let exact = closed_form(1e6, 0.3, 0.9, 1e-4);
+    let f = *rz.last().unwrap();
+    let rel = (f - exact).abs() / exact.abs();
+    println!("{formulation}: reaction {f:.6} N, closed form {exact:.6} N, rel error {rel:.2e}, energy error {:.2e}", err.last().unwrap());
+    assert!(rel < 5e-3, "reaction {f} vs closed form {exact}: {rel:.3e}");
+    assert!(
+        *err.last().unwrap() < 0.01,
+        "energy error {}",
+        err.last().unwrap()
+    );
+}
+
+#[test]
+fn compression_block_one_point_matches_closed_form() {
+    check("one_point");
+}
+
+#[test]
+fn compression_block_full_fbar_matches_closed_form() {
+    check("full_fbar");
+}
