@@ -1,0 +1,175 @@
+//! Phantom parameters, with defaults.
+
+use crate::voxel::MeshOptions;
+
+/// Voxel size (m) close to the paper's CT resolution (141 x 141 px per slice): gives about
+/// 550k hexahedra for the full abdomen and 110k for the reduced model.
+pub const PAPER_VOXEL: f64 = 0.003;
+
+/// Default voxel size (m): the reduced model has about 20k hexahedra, sized so that
+/// `palpa palpate` runs in about two minutes on two cores.
+pub const DEFAULT_VOXEL: f64 = 0.005;
+
+/// Which model to build.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum Variant {
+    /// The whole simplified abdomen (paper: 547,250 hexahedra).
+    Full,
+    /// The upper liver and the tissue around it, cropped to a box with rollers on the cut
+    /// planes and a fixed bottom (paper: 112,955 hexahedra).
+    #[default]
+    Reduced,
+}
+
+impl std::str::FromStr for Variant {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s {
+            "full" => Ok(Variant::Full),
+            "reduced" => Ok(Variant::Reduced),
+            _ => Err(format!("unknown phantom variant `{s}` (full | reduced)")),
+        }
+    }
+}
+
+/// A spherical liver tumour; it becomes its own part ("tumour", "tumour2", ...).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Tumour {
+    /// Centre (m) in the phantom frame at respiratory phase 0; it moves with the liver.
+    pub center: [f64; 3],
+    /// Radius (m).
+    pub radius: f64,
+    /// Stiffness relative to healthy liver (the caller scales the liver law by it).
+    pub stiffness_factor: f64,
+}
+
+/// Region of interest: liver elements on the liver's surface near a point.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RoiParams {
+    /// Centre (m); `None` = on the liver's inferior edge below the palpation grid's centre.
+    pub center: Option<[f64; 3]>,
+    /// Only surface elements with centroid within this distance of the centre (m).
+    pub radius: f64,
+    /// Keep at most this many, the nearest first (paper: 377).
+    pub max_count: Option<usize>,
+}
+
+impl Default for RoiParams {
+    fn default() -> Self {
+        RoiParams {
+            center: None,
+            radius: 0.06,
+            max_count: Some(377),
+        }
+    }
+}
+
+/// The 5 x 5 palpation raster, in the (x, y) plane of the body surface.
+#[derive(Clone, Debug, PartialEq)]
+pub struct GridParams {
+    /// Raster centre (x, y) (m).
+    pub center: [f64; 2],
+    /// Distance between neighbouring points along x and y (m).
+    pub spacing: [f64; 2],
+    /// Points along x and y.
+    pub n: [usize; 2],
+}
+
+impl Default for GridParams {
+    fn default() -> Self {
+        GridParams {
+            center: [-0.05, 0.195],
+            spacing: [0.025, 0.025],
+            n: [5, 5],
+        }
+    }
+}
+
+/// All phantom parameters. Lengths in m.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PhantomParams {
+    /// Full abdomen or reduced model.
+    pub variant: Variant,
+    /// Voxel edge length (m).
+    pub voxel: f64,
+    /// Subcutaneous fat (flesh) thickness over the muscle and rib layer (m).
+    pub fat_thickness: f64,
+    /// Respiratory phase, 0 = full exhalation (the paper's frame) to 1 = full inspiration.
+    pub respiratory_phase: f64,
+    /// Caudal liver displacement at phase 1 (m).
+    pub max_liver_shift: f64,
+    /// Torso width, left to right (m).
+    pub torso_width: f64,
+    /// Torso depth, back to front (m).
+    pub torso_depth: f64,
+    /// Torso length, caudal to cranial (m).
+    pub torso_length: f64,
+    /// Optional liver tumours.
+    pub tumours: Vec<Tumour>,
+    /// Meshing and smoothing options.
+    pub mesh: MeshOptions,
+    /// Region of interest.
+    pub roi: RoiParams,
+    /// Palpation raster.
+    pub grid: GridParams,
+}
+
+impl Default for PhantomParams {
+    fn default() -> Self {
+        PhantomParams {
+            variant: Variant::Reduced,
+            voxel: DEFAULT_VOXEL,
+            fat_thickness: 0.015,
+            respiratory_phase: 0.0,
+            max_liver_shift: 0.020,
+            torso_width: 0.30,
+            torso_depth: 0.22,
+            torso_length: 0.30,
+            tumours: Vec::new(),
+            mesh: MeshOptions::default(),
+            roi: RoiParams::default(),
+            grid: GridParams::default(),
+        }
+    }
+}
+
+impl PhantomParams {
+    /// Caudal liver displacement for the current phase (m).
+    pub fn liver_shift(&self) -> f64 {
+        self.respiratory_phase.clamp(0.0, 1.0) * self.max_liver_shift
+    }
+
+    /// Check ranges.
+    pub fn validate(&self) -> Result<(), String> {
+        if !(self.voxel > 0.0005 && self.voxel < 0.05) {
+            return Err(format!(
+                "voxel size {} m out of range (0.5 mm .. 50 mm)",
+                self.voxel
+            ));
+        }
+        if !(0.0..=0.05).contains(&self.fat_thickness) {
+            return Err(format!(
+                "fat thickness {} m out of range (0 .. 50 mm)",
+                self.fat_thickness
+            ));
+        }
+        if !(0.0..=1.0).contains(&self.respiratory_phase) {
+            return Err(format!(
+                "respiratory phase {} out of range 0..1",
+                self.respiratory_phase
+            ));
+        }
+        if self.torso_width < 0.2 || self.torso_depth < 0.15 || self.torso_length < 0.25 {
+            return Err("torso must be at least 200 x 150 x 250 mm".into());
+        }
+        for t in &self.tumours {
+            if !(t.radius > 0.0 && t.stiffness_factor > 0.0) {
+                return Err("tumour radius and stiffness factor must be positive".into());
+            }
+        }
+        if self.tumours.len() > 249 {
+            return Err("too many tumours".into());
+        }
+        Ok(())
+    }
+}

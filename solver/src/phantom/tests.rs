@@ -1,0 +1,216 @@
+use super::*;
+
+fn coarse(variant: Variant) -> PhantomParams {
+    PhantomParams {
+        variant,
+        voxel: 0.008,
+        ..Default::default()
+    }
+}
+
+#[test]
+fn coarse_full_phantom_has_all_parts_in_place() {
+    let ph = build(&coarse(Variant::Full)).unwrap();
+    let q = &ph.quality;
+    for (name, c) in &q.part_counts {
+        assert!(*c > 0, "part {name} is empty");
+    }
+    assert_eq!(q.n_nonpositive, 0);
+    assert!(q.min_scaled_jacobian > 0.0);
+    // centroids per part
+    let cents = ph.mesh.centroids();
+    let mean = |part: &str| {
+        let pid = ph.mesh.part_names.iter().position(|n| n == part).unwrap() as u32;
+        let (mut s, mut n) = ([0.0; 3], 0.0);
+        let mut ymax = f64::MIN;
+        for (e, c) in cents.iter().enumerate() {
+            if ph.mesh.element_part[e] == pid {
+                for k in 0..3 {
+                    s[k] += c[k];
+                }
+                n += 1.0;
+                ymax = ymax.max(c[1]);
+            }
+        }
+        ([s[0] / n, s[1] / n, s[2] / n], ymax)
+    };
+    let (liver, _) = mean("liver");
+    // right (x < 0) upper (cranial half) quadrant
+    assert!(liver[0] < -0.02, "liver centroid x = {}", liver[0]);
+    assert!(liver[1] > 0.15, "liver centroid y = {}", liver[1]);
+    // ribs over the liver: along vertical lines through the upper liver, a rib comes first
+    let (_, ribs_top) = mean("ribs");
+    assert!(ribs_top > liver[1]);
+    let (spine, _) = mean("spine");
+    assert!(spine[0].abs() < 0.01 && spine[2] < 0.08);
+    // back and skin sets
+    assert!(!ph.mesh.node_sets["back"].is_empty());
+    assert!(ph.mesh.node_sets["skin"].len() > 100);
+    assert!(!ph.mesh.node_sets["cut_ymax"].is_empty());
+}
+
+#[test]
+fn ribs_lie_between_skin_and_upper_liver() {
+    let vol = label_volume(&coarse(Variant::Full)).unwrap();
+    // count columns over the liver where a rib is above the liver, in the cranial part
+    let (mut under, mut total) = (0, 0);
+    for j in 0..vol.dims[1] {
+        for i in 0..vol.dims[0] {
+            let mut rib = false;
+            for k in (0..vol.dims[2]).rev() {
+                let l = vol.get(i, j, k);
+                if l == RIBS {
+                    rib = true;
+                }
+                if l == LIVER {
+                    if vol.voxel_center(i, j, k)[1] > 0.25 {
+                        total += 1;
+                        under += rib as usize;
+                    }
+                    break;
+                }
+            }
+        }
+    }
+    assert!(
+        total > 0 && under * 3 > total,
+        "{under} of {total} upper-liver columns under ribs"
+    );
+}
+
+#[test]
+fn reduced_phantom_roi_and_locations() {
+    let ph = build(&coarse(Variant::Reduced)).unwrap();
+    let q = &ph.quality;
+    assert_eq!(q.n_nonpositive, 0);
+    let full = build(&coarse(Variant::Full)).unwrap();
+    assert!(ph.mesh.n_elements() * 3 < full.mesh.n_elements());
+    // rollers on the cut planes, a fixed bottom
+    for s in ["back", "cut_xmax", "cut_ymin", "cut_ymax"] {
+        assert!(ph.mesh.node_sets[s].len() > 10, "node set {s}");
+    }
+    // cut planes are exactly planar after smoothing
+    let xs: Vec<f64> = ph.mesh.node_sets["cut_xmax"]
+        .iter()
+        .map(|&n| ph.mesh.nodes[n as usize][0])
+        .collect();
+    assert!(xs.iter().all(|&x| x == xs[0]));
+    // ROI: liver surface elements, a sane number at 8 mm
+    let n = ph.roi.elements.len();
+    assert!((20..=377).contains(&n), "ROI has {n} elements");
+    let liver = ph
+        .mesh
+        .part_names
+        .iter()
+        .position(|n| n == "liver")
+        .unwrap() as u32;
+    assert!(ph
+        .roi
+        .elements
+        .iter()
+        .all(|&e| ph.mesh.element_part[e as usize] == liver));
+    // locations
+    let l = &ph.locations;
+    assert_eq!(l.grid.len(), 25);
+    let (a, b, c) = (&l.a, &l.b, &l.c);
+    assert!(!a.under_ribs && !b.under_ribs && c.under_ribs);
+    let (da, db) = (a.liver_depth.unwrap(), b.liver_depth.unwrap());
+    assert!(db > da + 0.005, "depth A {da} B {db}");
+    assert!(c.liver_depth.is_some());
+    for x in [a, b, c] {
+        assert!(
+            x.inward_normal[2] < -0.5,
+            "{} normal {:?}",
+            x.name,
+            x.inward_normal
+        );
+        assert!(x.surface[2] > 0.15);
+    }
+    // JSON exports parse
+    let v: serde_json::Value = serde_json::from_str(&l.to_json()).unwrap();
+    assert_eq!(v["grid"].as_array().unwrap().len(), 25);
+    let r: serde_json::Value = serde_json::from_str(&ph.roi.to_json()).unwrap();
+    assert_eq!(r["elements"].as_array().unwrap().len(), n);
+}
+
+#[test]
+fn respiratory_phase_moves_the_liver_caudally() {
+    let y_liver = |phase: f64| {
+        let v = label_volume(&PhantomParams {
+            respiratory_phase: phase,
+            ..coarse(Variant::Full)
+        })
+        .unwrap();
+        let (mut s, mut n) = (0.0, 0.0);
+        for k in 0..v.dims[2] {
+            for j in 0..v.dims[1] {
+                for i in 0..v.dims[0] {
+                    if v.get(i, j, k) == LIVER {
+                        s += v.voxel_center(i, j, k)[1];
+                        n += 1.0;
+                    }
+                }
+            }
+        }
+        s / n
+    };
+    let d = y_liver(0.0) - y_liver(1.0);
+    assert!(d > 0.012 && d < 0.028, "liver moved {d} m");
+}
+
+#[test]
+fn tumour_becomes_its_own_part() {
+    let mut p = coarse(Variant::Reduced);
+    let an = Anatomy::new(&p);
+    let e = an.liver_edge_point(-0.07);
+    p.tumours.push(Tumour {
+        center: [e[0], e[1] + 0.05, e[2] - 0.02],
+        radius: 0.015,
+        stiffness_factor: 5.0,
+    });
+    let ph = build(&p).unwrap();
+    let t = ph
+        .quality
+        .part_counts
+        .iter()
+        .find(|(n, _)| n == "tumour")
+        .unwrap();
+    assert!(t.1 > 5, "tumour has {} elements", t.1);
+    assert_eq!(ph.tumours, vec![("tumour".to_string(), 5.0)]);
+}
+
+#[test]
+fn phantom_is_deterministic() {
+    let a = label_volume(&coarse(Variant::Reduced)).unwrap();
+    let b = label_volume(&coarse(Variant::Reduced)).unwrap();
+    assert_eq!(a, b);
+}
+
+/// Element counts and timings at the default and paper-like voxel; run with
+/// `cargo test --release -p solver phantom_report -- --ignored --nocapture`.
+#[test]
+#[ignore]
+fn phantom_report() {
+    for voxel in [DEFAULT_VOXEL, PAPER_VOXEL] {
+        for variant in [Variant::Full, Variant::Reduced] {
+            let t = std::time::Instant::now();
+            let ph = build(&PhantomParams {
+                variant,
+                voxel,
+                ..Default::default()
+            })
+            .unwrap();
+            println!(
+                "==== {variant:?} at {:.1} mm: built in {:.2} s",
+                voxel * 1e3,
+                t.elapsed().as_secs_f64()
+            );
+            println!("{}", ph.summary());
+            if let Ok(dir) = std::env::var("PALPA_PREVIEW_DIR") {
+                let d =
+                    std::path::Path::new(&dir).join(format!("{variant:?}-{:.0}mm", voxel * 1e3));
+                ph.write_preview(&d).unwrap();
+            }
+        }
+    }
+}
