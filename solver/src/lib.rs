@@ -12,9 +12,11 @@ pub mod hex;
 pub mod mesh;
 pub mod model;
 pub mod output;
+pub mod phantom;
 pub mod run;
 pub mod scene;
 pub mod simulation;
+pub mod voxel;
 
 pub use mesh::Mesh;
 pub use model::{Model, Part, SolverError};
