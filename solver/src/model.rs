@@ -126,7 +126,8 @@ pub struct Group {
     pub elements: Vec<u32>,
     /// Connectivity.
     pub conn: Vec<[u32; 8]>,
-    /// Mean gradient (one-point) or centre gradient (full), [component][node].
+    /// Mean gradient b_a = 1/V int grad N_a dV, [component][node] (F of one-point elements,
+    /// F0 of F-bar elements).
     pub grad: Vec<[[f64; 8]; 3]>,
     /// Reference volumes (m^3).
     pub vol0: Vec<f64>,
@@ -305,7 +306,7 @@ impl Model {
                         }
                     }
                     Formulation::Full { .. } => {
-                        g.grad.push(geo.centre_grad);
+                        g.grad.push(geo.mean_grad);
                         g.gp_grad.push(geo.gp_grad);
                         g.gp_weight.push(geo.gp_weight);
                     }

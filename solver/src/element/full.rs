@@ -1,12 +1,16 @@
 //! Fully integrated (2x2x2) hexahedron, total Lagrangian, with an optional F-bar treatment of
 //! the volumetric part (de Souza Neto, Peric, Dutko, Owen 1996, IJSS 33:3277).
 //!
-//! With F0 the deformation gradient at the element centre, J0 = det F0 and, at each Gauss
+//! With F0 = I + sum_a u_a (x) b_a the deformation gradient of the Flanagan-Belytschko mean
+//! gradient b_a (the volume average of grad N_a; for a parallelepiped the centre gradient),
+//! J0 = det F0 and, at each Gauss
 //! point, F, J = det F, r = (J0/J)^(1/3), the modified gradient is Fbar = r F. The law gives
 //! Pbar = Fbar S(Fbar). The nodal forces are the exact variation of the stored energy,
 //!   f_a = sum_gp w detJ r [ Pbar g_a + 1/3 (Pbar : F) (F0^-T g0_a - F^-T g_a) ],
-//! with g_a = grad N_a at the Gauss point and g0_a at the centre, so energy is conserved and the
-//! patch test is passed (for homogeneous F, r = 1 and the correction vanishes).
+//! with g_a = grad N_a at the Gauss point and g0_a = b_a, so energy is conserved and the patch
+//! test is passed on distorted meshes: for homogeneous F, r = 1, and the correction sums to
+//! (1/3)(P:F) F^-T sum_gp w detJ (b_a - g_a) = 0 because b_a is the volume average of g_a.
+//! (With the centre gradient instead, the correction does not vanish on distorted elements.)
 //! Without F-bar: f_a = sum_gp w detJ P g_a.
 
 use super::{
@@ -18,7 +22,7 @@ use material::{Law, LawError, Mat3};
 
 /// Reference data of one fully integrated element.
 pub struct FullRef<'a> {
-    /// Centre gradient [component][node] (1/m).
+    /// Mean gradient [component][node] (1/m).
     pub centre_grad: &'a [[f64; 8]; 3],
     /// Gauss-point gradients.
     pub gp_grad: &'a [[[f64; 8]; 3]; 8],
