@@ -12,9 +12,24 @@ fn gradients() -> Vec<Mat3> {
     (0..64)
         .map(|k| {
             let s = k as f64 / 63.0;
-            let (a, b, c) = (0.3 * s - 0.15, 0.1 * (s * 7.0).sin(), 0.05 * (s * 3.0).cos());
-            let stretch = Mat3::new(1.0 + a, b, 0.0, b * 0.5, 1.0 - 0.5 * a, c, 0.0, c * 0.3, 1.0 - 0.4 * a);
-            let rot = nalgebra::Rotation3::from_euler_angles(0.2 * s, -0.4 * s, 0.7 * s).into_inner();
+            let (a, b, c) = (
+                0.3 * s - 0.15,
+                0.1 * (s * 7.0).sin(),
+                0.05 * (s * 3.0).cos(),
+            );
+            let stretch = Mat3::new(
+                1.0 + a,
+                b,
+                0.0,
+                b * 0.5,
+                1.0 - 0.5 * a,
+                c,
+                0.0,
+                c * 0.3,
+                1.0 - 0.4 * a,
+            );
+            let rot =
+                nalgebra::Rotation3::from_euler_angles(0.2 * s, -0.4 * s, 0.7 * s).into_inner();
             rot * stretch
         })
         .collect()

@@ -778,6 +778,12 @@ impl ContactStage {
         self.capped
     }
 
+    /// Faces that carried a contact force in the last evaluation (indices into the surface's
+    /// faces, each once): exactly the faces whose nodes received force.
+    pub fn touched_faces(&self) -> &[u32] {
+        &self.touched
+    }
+
     /// Pressure penalty `eps_f = k_f / A_f` of each face (N/m^3), after the cap.
     pub fn face_penalty(&self) -> impl ExactSizeIterator<Item = f64> + '_ {
         self.data.iter().map(|d| d.eps)

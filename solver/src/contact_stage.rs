@@ -1,41 +1,657 @@
-//! The contact stage of the time loop (placeholder; being written).
+//! The contact stage of the time loop: the `contact` crate's penalty contact behind the solver's
+//! [`ForceStage`] interface, built from the scene's `[[indenter]]`, `[[hand]]` and `[contact]`
+//! tables (see [`crate::scene::contact_spec`] for the format and the default penalty).
+//!
+//! ## Surface
+//! The contact surface is the mesh boundary ([`crate::mesh::Mesh::boundary_faces`], outward
+//! quads), optionally restricted to the faces whose four nodes all lie in `[contact] surface`
+//! (a node set) and to the elements of `[contact] parts`. Per face the segment formula gets
+//! `K = rho c0^2` of the owning element's law (the P-wave modulus `lambda + 2 mu` at the
+//! reference state, from [`material::Material::initial_wave_speed`] and the density) and the
+//! element's reference volume; the soft formula and the time-step bound use the lumped nodal
+//! masses of the model (after mass scaling).
+//!
+//! ## Time step
+//! The crate bounds the contact alone by `dt_c = min_a 2 sqrt(m_a / k_a)` (Gershgorin row sums
+//! of the penalty stiffness). The largest eigenvalues of element and contact stiffness add at
+//! most, so body plus contact is stable when `(dt/dt_e)^2 + (dt/dt_c)^2 <= 1`. The solver already
+//! keeps `dt <= f dt_e` (`f` = `dt_factor`, 0.9), so this stage's [`ForceStage::max_dt`] is
+//! `dt_c sqrt(1 - f^2)` (with `f` taken as at most 0.9). With the default penalty (capped at
+//! `k_a <= 0.1 m_a (2/dt_0)^2`, `dt_0` the design step) this is `1.38 dt_0` and never binds;
+//! it binds only when a scene raises the penalty beyond the cap, and then it lowers the step
+//! instead of letting the run blow up.
+//!
+//! ## Energy
+//! The crate's identity is `KE + IE + E_contact = W_other + W_drive`, with `E_contact` the stored
+//! penalty energy plus contact dissipation and `W_drive` the work of the indenter drivers. The
+//! solver's own external-work sum includes the work of the contact forces on the body, so this
+//! stage also accumulates that work, `W_body = sum_n (f^(n-1) + f^n)/2 . v^(n-1/2) (t^n - t^(n-1))`
+//! over the nodes that carry contact force (the same trapezoidal rule as the solver's sums), and
+//! the simulation books `W_external = W_solver - W_body + W_drive` and `E_contact`. The balance then
+//! checks the contact too: it closes only if the contact forces are the gradient of the penalty
+//! energy and the driver work is right.
+//!
+//! ## Output
+//! Per indenter, `history.csv` gets `<name>_force_x/_y/_z`: the force the body exerts on the
+//! indenter (N), i.e. the resultant on the rigid (master) side as LS-DYNA's RCFORC reports it
+//! for a rigid master surface: pressing down (-z) into a body gives a positive `force_z`;
+//! `<name>_reaction`: that force along `-direction` (N, positive when pressing);
+//! `<name>_travel`: the indenter's travel along its direction (m); `<name>_depth`: travel since
+//! first contact (m); `<name>_area`: current area of the penetrating sample points (m^2);
+//! `<name>_max_penetration` (m). The VTK frames get `contact_pressure` (Pa), per node the mean of
+//! the contact pressures of its surface faces.
 
-use crate::scene::contact_spec::{ContactScene, HandScene, IndenterScene};
+use crate::scene::contact_spec::{
+    ContactScene, HandScene, IndenterScene, MotionScene, ShapeScene, DEFAULT_SOFT_SCALE,
+};
+use crate::scene::spec::CurveSpec;
 use crate::simulation::{ForceStage, Simulation};
+use contact::{
+    ContactParams, ContactStage, ContactSurface, Curve, ForceControl, HandSpec, IndenterSpec,
+    MotionSpec, PenaltyKind, ShapeSpec,
+};
+use std::collections::HashSet;
 use std::path::Path;
 
-/// Adapter from the `contact` crate to the solver's force-stage interface.
-pub struct ContactForceStage;
+/// The contact stage: the `contact` crate's [`ContactStage`] plus the bookkeeping the solver needs
+/// (the work of the contact forces on the body, the time-step bound, output columns and fields).
+pub struct ContactForceStage {
+    stage: ContactStage,
+    faces: Vec<[u32; 4]>,
+    /// Contact forces of the last evaluation (N), nonzero only on `nodes`.
+    fc: Vec<[f64; 3]>,
+    mark: Vec<bool>,
+    nodes: Vec<u32>,
+    /// Surface faces per node (for the nodal pressure average).
+    node_faces: Vec<u32>,
+    body_work: f64,
+    t_prev: Option<f64>,
+    max_dt: f64,
+    columns: Vec<String>,
+}
+
+impl ContactForceStage {
+    /// Wrap a contact stage. `faces` must be the surface faces the stage was built with,
+    /// `dt_factor` the solver's time-step factor.
+    pub fn new(stage: ContactStage, faces: Vec<[u32; 4]>, n_nodes: usize, dt_factor: f64) -> Self {
+        let mut node_faces = vec![0u32; n_nodes];
+        for f in &faces {
+            for &a in f {
+                node_faces[a as usize] += 1;
+            }
+        }
+        let f = dt_factor.min(0.9);
+        let max_dt = stage.stable_dt_bound() * (1.0 - f * f).sqrt();
+        let mut columns = Vec::new();
+        for s in stage.indenters() {
+            for c in [
+                "force_x",
+                "force_y",
+                "force_z",
+                "reaction",
+                "travel",
+                "depth",
+                "area",
+                "max_penetration",
+            ] {
+                columns.push(format!("{}_{c}", s.name));
+            }
+        }
+        ContactForceStage {
+            stage,
+            faces,
+            fc: vec![[0.0; 3]; n_nodes],
+            mark: vec![false; n_nodes],
+            nodes: Vec::with_capacity(n_nodes.min(1 << 16)),
+            node_faces,
+            body_work: 0.0,
+            t_prev: None,
+            max_dt,
+            columns,
+        }
+    }
+
+    /// The wrapped contact stage (indenter states, counters, penalties).
+    pub fn stage(&self) -> &ContactStage {
+        &self.stage
+    }
+
+    /// Work done by the contact forces on the body so far (J).
+    pub fn body_work(&self) -> f64 {
+        self.body_work
+    }
+}
+
+#[inline]
+fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+}
 
 impl ForceStage for ContactForceStage {
     fn name(&self) -> &'static str {
         "contact"
     }
-    fn apply(
-        &mut self,
-        _t: f64,
-        _dt: f64,
-        _x: &[[f64; 3]],
-        _v: &[[f64; 3]],
-        _force: &mut [[f64; 3]],
-    ) {
+
+    fn apply(&mut self, t: f64, dt: f64, x: &[[f64; 3]], v: &[[f64; 3]], force: &mut [[f64; 3]]) {
+        let dtp = self.t_prev.map_or(0.0, |tp| t - tp);
+        self.t_prev = Some(t);
+        // f^(n-1) . v^(n-1/2) dt / 2, and clear the previous forces.
+        let mut w = 0.0;
+        for &a in &self.nodes {
+            let a = a as usize;
+            w += dot(self.fc[a], v[a]);
+            self.fc[a] = [0.0; 3];
+            self.mark[a] = false;
+        }
+        self.nodes.clear();
+        self.stage.apply(t, dt, x, v, &mut self.fc);
+        for &fi in self.stage.touched_faces() {
+            for &a in &self.faces[fi as usize] {
+                if !self.mark[a as usize] {
+                    self.mark[a as usize] = true;
+                    self.nodes.push(a);
+                }
+            }
+        }
+        // f^n . v^(n-1/2) dt / 2, and add the forces to the solver's array.
+        for &a in &self.nodes {
+            let a = a as usize;
+            let f = self.fc[a];
+            w += dot(f, v[a]);
+            let o = &mut force[a];
+            o[0] += f[0];
+            o[1] += f[1];
+            o[2] += f[2];
+        }
+        self.body_work += 0.5 * dtp * w;
     }
+
     fn energy(&self) -> f64 {
-        0.0
+        self.stage.energy()
+    }
+
+    fn body_work(&self) -> f64 {
+        self.body_work
+    }
+
+    fn driver_work(&self) -> f64 {
+        self.stage.driver_work()
+    }
+
+    fn max_dt(&self) -> f64 {
+        self.max_dt
+    }
+
+    fn history_columns(&self) -> Vec<String> {
+        self.columns.clone()
+    }
+
+    fn history_values(&self, out: &mut Vec<f64>) {
+        for s in self.stage.indenters() {
+            out.extend([
+                s.force[0],
+                s.force[1],
+                s.force[2],
+                s.reaction,
+                s.travel,
+                s.depth,
+                s.area,
+                s.max_penetration,
+            ]);
+        }
+    }
+
+    fn point_fields(&self) -> Vec<(String, Vec<f64>)> {
+        let mut p = vec![0.0; self.node_faces.len()];
+        for (f, &pf) in self.faces.iter().zip(self.stage.face_pressure()) {
+            if pf != 0.0 {
+                for &a in f {
+                    p[a as usize] += pf;
+                }
+            }
+        }
+        for (p, &n) in p.iter_mut().zip(&self.node_faces) {
+            if n > 0 {
+                *p /= n as f64;
+            }
+        }
+        vec![("contact_pressure".into(), p)]
     }
 }
 
-/// Build the contact stage for a scene.
+fn v3(l: &[material::quantity::Length; 3]) -> [f64; 3] {
+    [l[0].0, l[1].0, l[2].0]
+}
+
+fn shape(s: &ShapeScene, base: &Path) -> ShapeSpec {
+    match s {
+        ShapeScene::Sphere { center, radius } => ShapeSpec::Sphere {
+            center: v3(center),
+            radius: radius.0,
+        },
+        ShapeScene::Capsule {
+            center,
+            axis,
+            radius,
+            length,
+        } => ShapeSpec::Capsule {
+            center: v3(center),
+            axis: *axis,
+            radius: radius.0,
+            length: length.0,
+        },
+        ShapeScene::Cylinder {
+            center,
+            axis,
+            radius,
+            length,
+        } => ShapeSpec::Cylinder {
+            center: v3(center),
+            axis: *axis,
+            radius: radius.0,
+            length: length.0,
+        },
+        ShapeScene::Box {
+            center,
+            half_extents,
+            axes,
+        } => ShapeSpec::Box {
+            center: v3(center),
+            half_extents: v3(half_extents),
+            axes: *axes,
+        },
+        ShapeScene::Plane { point, normal } => ShapeSpec::Plane {
+            point: v3(point),
+            normal: *normal,
+        },
+        ShapeScene::Stl {
+            path,
+            unit,
+            translate,
+        } => ShapeSpec::Stl {
+            path: base.join(path),
+            scale: unit.map_or(1.0, |u| u.0),
+            translate: translate.as_ref().map_or([0.0; 3], v3),
+        },
+    }
+}
+
+fn motion_curve<Q: Copy + Into<f64>>(c: &CurveSpec<Q>) -> Result<Curve, String> {
+    Ok(match c {
+        CurveSpec::Constant { value } => Curve::Constant {
+            value: (*value).into(),
+        },
+        CurveSpec::SmoothStep {
+            value,
+            from,
+            start,
+            end,
+        } => {
+            if from.is_some_and(|f| Into::<f64>::into(f) != 0.0) {
+                return Err("an indenter's smooth_step starts from 0 (drop `from`)".into());
+            }
+            let t0 = start.map_or(0.0, |t| t.0);
+            Curve::SmoothStep {
+                amplitude: (*value).into(),
+                duration: end.0 - t0,
+                start: t0,
+            }
+        }
+        CurveSpec::Ramp { value, start, end } => {
+            let t0 = start.map_or(0.0, |t| t.0);
+            Curve::Ramp {
+                amplitude: (*value).into(),
+                duration: end.0 - t0,
+                start: t0,
+            }
+        }
+        CurveSpec::Table { time, value } => {
+            if time.len() != value.len() {
+                return Err(format!(
+                    "table has {} times but {} values",
+                    time.len(),
+                    value.len()
+                ));
+            }
+            Curve::Table {
+                points: time
+                    .iter()
+                    .zip(value)
+                    .map(|(t, v)| [t.0, (*v).into()])
+                    .collect(),
+            }
+        }
+    })
+}
+
+fn motion(m: &MotionScene) -> Result<MotionSpec, String> {
+    Ok(match m {
+        MotionScene::Fixed => MotionSpec::Fixed,
+        MotionScene::Displacement { curve } => MotionSpec::Displacement {
+            curve: motion_curve(curve)?,
+        },
+        MotionScene::Velocity { curve } => MotionSpec::Velocity {
+            curve: motion_curve(curve)?,
+        },
+        MotionScene::Force {
+            target,
+            ramp_time,
+            approach_speed,
+            time_constant,
+            filter_time,
+        } => {
+            let mut fc = ForceControl::new(target.0);
+            if let Some(t) = ramp_time {
+                fc.ramp_time = t.0;
+            }
+            if let Some(v) = approach_speed {
+                fc.approach_speed = v.0;
+            }
+            if let Some(t) = time_constant {
+                fc.time_constant = t.0;
+            }
+            if let Some(t) = filter_time {
+                fc.filter_time = t.0;
+            }
+            MotionSpec::Force(fc)
+        }
+    })
+}
+
+/// The contact parameters a `[contact]` table asks for, with palpa's defaults (soft penalty,
+/// `soft_scale` 0.4, design step = the run's initial step; see [`crate::scene::contact_spec`]).
+/// `design_dt` is the default design step (s).
+pub fn contact_params(c: Option<&ContactScene>, design_dt: f64) -> Result<ContactParams, String> {
+    let d = ContactScene::default();
+    let c = c.unwrap_or(&d);
+    let mut p = ContactParams {
+        penalty: PenaltyKind::Soft,
+        soft_scale: DEFAULT_SOFT_SCALE,
+        design_dt: Some(c.design_dt.map_or(design_dt, |t| t.0)),
+        ..ContactParams::default()
+    };
+    if let Some(k) = &c.penalty {
+        p.penalty = match k.as_str() {
+            "soft" => PenaltyKind::Soft,
+            "segment" => PenaltyKind::Segment,
+            "max" => PenaltyKind::Max,
+            o => {
+                return Err(format!(
+                    "contact.penalty must be `soft`, `segment` or `max`, got `{o}`"
+                ))
+            }
+        };
+    }
+    if let Some(x) = c.penalty_scale {
+        p.penalty_scale = x.0;
+    }
+    if let Some(x) = c.soft_scale {
+        p.soft_scale = x.0;
+    }
+    if let Some(x) = c.stiffness_cap {
+        p.stiffness_cap = (x.0 > 0.0).then_some(x.0);
+    }
+    if let Some(x) = c.friction {
+        p.friction = x.0;
+    }
+    if let Some(x) = c.friction_velocity {
+        p.friction_velocity = x.0;
+    }
+    if let Some(x) = c.damping_ratio {
+        p.damping_ratio = x.0;
+    }
+    if let Some(x) = c.samples_min {
+        p.samples_min = x;
+    }
+    if let Some(x) = c.samples_max {
+        p.samples_max = x;
+    }
+    if let Some(x) = c.sample_spacing {
+        p.sample_spacing = x.0;
+    }
+    if let Some(x) = c.margin {
+        p.margin = Some(x.0);
+    }
+    if let Some(x) = c.rebuild_interval {
+        p.rebuild_interval = x;
+    }
+    Ok(p)
+}
+
+/// The contact crate's hand for a scene's `[[hand]]`, with the fingertips `gap` (m) back.
+fn hand_spec(h: &HandScene, gap: f64) -> Result<HandSpec, String> {
+    let (Some(point), Some(direction)) = (&h.point, h.direction) else {
+        return Err(
+            "a hand needs `point` and `direction`, or `location`/`at` on a phantom mesh".into(),
+        );
+    };
+    Ok(HandSpec {
+        name: h.name.clone(),
+        point: v3(point),
+        direction,
+        spacing_axis: h.spacing_axis,
+        diameter: h.diameter.0,
+        spacing: h.spacing.0,
+        length: h.length.0,
+        tilt: h.tilt_deg.unwrap_or(0.0).to_radians(),
+        gap,
+        motion: motion(&h.motion)?,
+        friction: h.friction.map(|f| f.0),
+    })
+}
+
+/// Build the contact stage for a scene: indenters and hands in SI, the contact surface from the
+/// mesh boundary, and the parameters. `path` is the scene file (for messages and relative STL
+/// paths), `src` its text (for line numbers).
 pub fn build_stage(
-    _sim: &Simulation,
-    _indenters: &[IndenterScene],
-    _hands: &[HandScene],
-    _contact: Option<&ContactScene>,
+    sim: &Simulation,
+    indenters: &[IndenterScene],
+    hands: &[HandScene],
+    contact: Option<&ContactScene>,
     path: &Path,
-    _src: &str,
+    src: &str,
+    notes: &mut Vec<String>,
 ) -> Result<ContactForceStage, String> {
-    Err(format!(
-        "{}: contact is not implemented yet",
-        path.display()
+    let at = |needle: &str, key: &str, msg: &dyn std::fmt::Display| {
+        let line = src
+            .lines()
+            .position(|l| l.contains(needle))
+            .map(|i| format!(":{}", i + 1))
+            .unwrap_or_default();
+        format!("{}{line}: `{key}`: {msg}", path.display())
+    };
+    let base = path.parent().unwrap_or(Path::new("."));
+    let mut specs = Vec::new();
+    for (i, ind) in indenters.iter().enumerate() {
+        let key = format!("indenter[{i}]");
+        let name_at = format!("\"{}\"", ind.name);
+        if ind.part.is_empty() {
+            return Err(at(&name_at, &key, &"an indenter needs at least one `part`"));
+        }
+        specs.push(IndenterSpec {
+            name: ind.name.clone(),
+            parts: ind.part.iter().map(|s| shape(s, base)).collect(),
+            direction: ind.direction,
+            motion: motion(&ind.motion).map_err(|m| at(&name_at, &key, &m))?,
+            friction: ind.friction.map(|f| f.0),
+        });
+    }
+    for (i, h) in hands.iter().enumerate() {
+        let key = format!("hand[{i}]");
+        let name_at = format!("\"{}\"", h.name);
+        let hs = hand_spec(h, h.gap.map_or(0.0, |g| g.0)).map_err(|m| at(&name_at, &key, &m))?;
+        specs.push(hs.to_indenter_spec().map_err(|e| at(&name_at, &key, &e))?);
+    }
+    let mut names = HashSet::new();
+    for s in &specs {
+        if !names.insert(s.name.as_str()) {
+            return Err(at(
+                &format!("\"{}\"", s.name),
+                "indenter.name",
+                &format!("two indenters or hands are named `{}`", s.name),
+            ));
+        }
+    }
+
+    // Surface.
+    let model = &sim.model;
+    let mesh = &model.mesh;
+    let c = contact;
+    let in_set: Option<Vec<bool>> = match c.and_then(|c| c.surface.as_ref()) {
+        None => None,
+        Some(name) => {
+            let nodes = mesh.node_sets.get(name).ok_or_else(|| {
+                let known: Vec<&String> = mesh.node_sets.keys().collect();
+                at(
+                    &format!("\"{name}\""),
+                    "contact.surface",
+                    &format!("no node set `{name}`; known: {known:?}"),
+                )
+            })?;
+            let mut m = vec![false; mesh.nodes.len()];
+            for &n in nodes {
+                m[n as usize] = true;
+            }
+            Some(m)
+        }
+    };
+    let part_ok: Option<Vec<bool>> = match c.and_then(|c| c.parts.as_ref()) {
+        None => None,
+        Some(ps) => {
+            let mut ok = vec![false; mesh.part_names.len()];
+            for p in ps {
+                let i = mesh.part_names.iter().position(|n| n == p).ok_or_else(|| {
+                    at(
+                        &format!("\"{p}\""),
+                        "contact.parts",
+                        &format!("no part `{p}`; parts: {:?}", mesh.part_names),
+                    )
+                })?;
+                ok[i] = true;
+            }
+            Some(ok)
+        }
+    };
+    let mut vol = vec![0.0; mesh.elements.len()];
+    for g in &model.groups {
+        for (&e, &v) in g.elements.iter().zip(&g.vol0) {
+            vol[e as usize] = v;
+        }
+    }
+    let modulus: Vec<f64> = model
+        .parts
+        .iter()
+        .map(|p| {
+            let c0 = p.material.initial_wave_speed();
+            p.material.density() * c0 * c0
+        })
+        .collect();
+    let mut surface = ContactSurface::default();
+    for f in mesh.boundary_faces() {
+        let part = mesh.element_part[f.element as usize] as usize;
+        if let Some(ok) = &part_ok {
+            if !ok[part] {
+                continue;
+            }
+        }
+        if let Some(m) = &in_set {
+            if !f.nodes.iter().all(|&n| m[n as usize]) {
+                continue;
+            }
+        }
+        surface.faces.push(f.nodes);
+        surface.face_bulk_modulus.push(modulus[part]);
+        surface.face_element_volume.push(vol[f.element as usize]);
+    }
+    if surface.faces.is_empty() {
+        return Err(format!(
+            "{}: `contact`: the contact surface has no face (check `surface` and `parts`)",
+            path.display()
+        ));
+    }
+
+    // Initial penetration: a hand without an explicit `gap` whose fingertips start inside the
+    // surface (a curved skin under two fingers) is backed off until they just touch it; a hand
+    // placed on a phantom location then travels that much further, so that its indentation
+    // beyond first contact is the requested one. Any other indenter that starts inside the
+    // surface by more than 5 % of its feature size is an error that names it.
+    let design_dt = (sim.settings.dt_factor * model.scaled_dt).min(sim.settings.dt_max);
+    let params = contact_params(c, design_dt).map_err(|m| at("[contact]", "contact", &m))?;
+    // Largest penetration of each indenter at t = 0 over the face samples, as the stage sees it.
+    let zeros = vec![[0.0; 3]; mesh.nodes.len()];
+    let measure = |specs: &[IndenterSpec]| -> Result<Vec<f64>, String> {
+        let mut st =
+            ContactStage::new(specs, surface.clone(), &mesh.nodes, &model.mass, params.clone())
+                .map_err(|e| format!("{}: {e}", path.display()))?;
+        let mut f = zeros.clone();
+        st.apply(0.0, design_dt, &mesh.nodes, &zeros, &mut f);
+        Ok(st.indenters().iter().map(|s| s.max_penetration).collect())
+    };
+    let n_ind = indenters.len();
+    let mut gaps = vec![0.0; hands.len()];
+    for _ in 0..20 {
+        let pens = measure(&specs)?;
+        let mut moved = false;
+        for (k, h) in hands.iter().enumerate() {
+            if h.gap.is_none() && pens[n_ind + k] > 1e-9 {
+                gaps[k] += pens[n_ind + k] + 1e-7;
+                specs[n_ind + k] = hand_spec(h, gaps[k])
+                    .and_then(|hs| hs.to_indenter_spec().map_err(|e| e.to_string()))
+                    .map_err(|m| at(&format!("\"{}\"", h.name), "hand", &m))?;
+                moved = true;
+            }
+        }
+        if !moved {
+            for (spec, pen) in specs.iter().zip(&pens) {
+                let size = contact::Indenter::from_spec(spec)
+                    .map(|i| i.feature_size())
+                    .unwrap_or(f64::INFINITY);
+                if *pen > 0.05 * size {
+                    return Err(at(
+                        &format!("\"{}\"", spec.name),
+                        "indenter",
+                        &format!(
+                            "`{}` starts {:.3} mm inside the contact surface; move it out (or give a hand no `gap`, and palpa backs it off)",
+                            spec.name,
+                            pen * 1e3
+                        ),
+                    ));
+                }
+            }
+            break;
+        }
+    }
+    for (k, h) in hands.iter().enumerate() {
+        let gap = gaps[k];
+        if gap <= 0.0 {
+            continue;
+        }
+        let placed = h.location.is_some() || h.at.is_some();
+        if placed {
+            if let MotionSpec::Displacement { curve } = &mut specs[n_ind + k].motion {
+                if let Curve::SmoothStep { amplitude, .. } | Curve::Ramp { amplitude, .. } = curve {
+                    *amplitude += gap;
+                }
+            }
+        }
+        notes.push(format!(
+            "hand `{}`: the fingertips started {:.3} mm inside the contact surface; backed off by that much{}",
+            h.name,
+            gap * 1e3,
+            if placed {
+                " and the travel extended to match"
+            } else {
+                " (set `gap` to choose)"
+            }
+        ));
+    }
+    let faces = surface.faces.clone();
+    let stage = ContactStage::new(&specs, surface, &mesh.nodes, &model.mass, params)
+        .map_err(|e| format!("{}: {e}", path.display()))?;
+    Ok(ContactForceStage::new(
+        stage,
+        faces,
+        mesh.nodes.len(),
+        sim.settings.dt_factor,
     ))
 }

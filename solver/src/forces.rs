@@ -6,7 +6,7 @@
 //! thread count, so results are bitwise identical on 1 or N threads. Chunk partial results
 //! (minimum step, energy rates) are reduced serially in chunk order for the same reason.
 
-use crate::element::{full, one_point, ElementOut, Formulation, StepInput};
+use crate::element::{full, one_point, ElementOut, Formulation, Nodal, StepInput};
 use crate::model::{ChunkOut, Group, Model, Part, CHUNK};
 use material::with_law;
 use rayon::prelude::*;
@@ -37,6 +37,7 @@ impl<T> Shared<T> {
     /// # Safety
     /// The caller guarantees that no two live slices overlap.
     #[inline(always)]
+    #[allow(clippy::mut_from_ref)]
     unsafe fn slice(&self, start: usize, len: usize) -> &mut [T] {
         std::slice::from_raw_parts_mut(self.0.add(start), len)
     }
@@ -51,7 +52,7 @@ pub fn element_loop(
     u: &[[f64; 3]],
     v: &[[f64; 3]],
     input: &StepInput,
-    slots: &mut [[[f64; 3]; 8]],
+    slots: &mut [Nodal],
     stress: Option<&mut [[f64; 6]]>,
 ) -> Result<ElementTotals, (u32, String)> {
     let stress_ptr = stress.map(|s| Shared(s.as_mut_ptr()));
@@ -70,7 +71,7 @@ pub fn element_loop(
         let (elements, conn, grad, vol0) = (&g.elements, &g.conn, &g.grad, &g.vol0);
         let (gamma, hgk, gpg, gpw, dscale) = (
             &g.gamma,
-            &g.hg_stiffness,
+            &g.hg_scale,
             &g.gp_grad,
             &g.gp_weight,
             &g.density_scale,
@@ -81,15 +82,17 @@ pub fn element_loop(
                 for (k, fe) in fch.iter_mut().enumerate() {
                     let le = ci * CHUNK + k;
                     let c = &conn[le];
-                    let mut xe = [[0.0; 3]; 8];
-                    let mut ue = [[0.0; 3]; 8];
-                    let mut ve = [[0.0; 3]; 8];
+                    let mut xe: Nodal = [[0.0; 8]; 3];
+                    let mut ue: Nodal = [[0.0; 8]; 3];
+                    let mut ve: Nodal = [[0.0; 8]; 3];
                     for a in 0..8 {
                         let nd = c[a] as usize;
-                        ue[a] = u[nd];
-                        ve[a] = v[nd];
-                        let xr = x_ref[nd];
-                        xe[a] = [xr[0] + ue[a][0], xr[1] + ue[a][1], xr[2] + ue[a][2]];
+                        let (un, vn, xr) = (u[nd], v[nd], x_ref[nd]);
+                        for i in 0..3 {
+                            ue[i][a] = un[i];
+                            ve[i][a] = vn[i];
+                            xe[i][a] = xr[i] + un[i];
+                        }
                     }
                     let s = if dscale.is_empty() { 1.0 } else { dscale[le] };
                     // SAFETY: element le owns history[le*stride..(le+1)*stride] alone.
@@ -100,9 +103,9 @@ pub fn element_loop(
                                 grad: &grad[le],
                                 gamma: &gamma[le],
                                 vol0: vol0[le],
-                                hg_stiffness: if hgk.is_empty() { 0.0 } else { hgk[le] },
+                                hg_scale: hgk[le],
                             };
-                            one_point::compute_forces(l, &rf, hg.form, hg.coefficient, &xe, &ue, &ve, s, input, h, fe)
+                            one_point::compute_forces(l, &rf, hg.form, &xe, &ue, &ve, s, input, h, fe)
                         }
                         Formulation::Full { fbar } => {
                             let rf = full::FullRef {
@@ -136,7 +139,7 @@ pub fn element_loop(
                             if acc.error.is_none() {
                                 acc.error = Some((elements[le], e.to_string()));
                             }
-                            *fe = [[0.0; 3]; 8];
+                            *fe = [[0.0; 8]; 3];
                         }
                     }
                 }
@@ -161,8 +164,7 @@ pub fn element_loop(
 }
 
 /// Gather element slots into nodal forces: f[n] = sum of its slots, in table order.
-pub fn gather(model: &Model, slots: &[[[f64; 3]; 8]], f: &mut [[f64; 3]]) {
-    let flat: &[[f64; 3]] = slots.as_flattened();
+pub fn gather(model: &Model, slots: &[Nodal], f: &mut [[f64; 3]]) {
     let ptr = &model.gather_ptr;
     let idx = &model.gather_idx;
     f.par_chunks_mut(4096).enumerate().for_each(|(ci, ch)| {
@@ -170,10 +172,11 @@ pub fn gather(model: &Model, slots: &[[[f64; 3]; 8]], f: &mut [[f64; 3]]) {
             let n = ci * 4096 + k;
             let mut s = [0.0; 3];
             for &sl in &idx[ptr[n] as usize..ptr[n + 1] as usize] {
-                let v = flat[sl as usize];
-                s[0] += v[0];
-                s[1] += v[1];
-                s[2] += v[2];
+                let (e, a) = ((sl >> 3) as usize, (sl & 7) as usize);
+                let v = &slots[e];
+                s[0] += v[0][a];
+                s[1] += v[1][a];
+                s[2] += v[2][a];
             }
             *fn_ = s;
         }

@@ -184,35 +184,6 @@ pub fn hourglass_gamma(x: &[[f64; 3]; 8], b: &[[f64; 8]; 3]) -> [[f64; 8]; 4] {
     gamma
 }
 
-/// Largest face area of an element with current coordinates `x` (m^2); each face's area is
-/// half the norm of the cross product of its diagonals (exact for planar quads).
-#[inline]
-pub fn max_face_area(x: &[[f64; 3]; 8]) -> f64 {
-    let mut amax: f64 = 0.0;
-    for f in crate::mesh::FACES.iter() {
-        let d1 = sub(x[f[2]], x[f[0]]);
-        let d2 = sub(x[f[3]], x[f[1]]);
-        let c = cross(d1, d2);
-        let a2 = c[0] * c[0] + c[1] * c[1] + c[2] * c[2];
-        amax = amax.max(a2);
-    }
-    0.5 * amax.sqrt()
-}
-
-#[inline]
-pub(crate) fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-
-#[inline]
-pub(crate) fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -267,7 +238,6 @@ mod tests {
         }
         let g = element_geometry(&x).unwrap();
         assert!((g.volume - 1.0).abs() < 1e-14);
-        assert!((max_face_area(&x) - 1.0).abs() < 1e-14);
     }
 
     #[test]

@@ -12,6 +12,7 @@ pub mod hex;
 pub mod mesh;
 pub mod model;
 pub mod output;
+pub mod palpation;
 pub mod phantom;
 pub mod run;
 pub mod scene;

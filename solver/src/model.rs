@@ -15,7 +15,8 @@
 //! The added mass is reported per part.
 
 use crate::element::{Formulation, HourglassForm};
-use crate::hex::{element_geometry, hourglass_gamma, max_face_area};
+use crate::element::max_face_area;
+use crate::hex::{element_geometry, hourglass_gamma};
 use crate::mesh::Mesh;
 use material::Material;
 use std::fmt;
@@ -133,8 +134,9 @@ pub struct Group {
     pub vol0: Vec<f64>,
     /// Hourglass vectors (one-point only).
     pub gamma: Vec<[[f64; 8]; 4]>,
-    /// Hourglass stiffness a_s (one-point stiffness form only).
-    pub hg_stiffness: Vec<f64>,
+    /// Hourglass scale per element (one-point only): a_s (N/m) for the stiffness form,
+    /// Q rho0 V0^(2/3) / 4 (kg/m) for the viscous form.
+    pub hg_scale: Vec<f64>,
     /// Gauss-point gradients (full only).
     pub gp_grad: Vec<[[[f64; 8]; 3]; 8]>,
     /// Gauss-point weights (full only).
@@ -194,7 +196,8 @@ pub struct Model {
     pub mass: Vec<f64>,
     /// Per-part mass report.
     pub part_mass: Vec<PartMass>,
-    /// Gather table: for node n, slots gather_idx[gather_ptr[n]..gather_ptr[n+1]] (slot = 8 * element slot + local node).
+    /// Gather table: for node n, entries gather_idx[gather_ptr[n]..gather_ptr[n+1]], each
+    /// 8 * element slot + local node.
     pub gather_ptr: Vec<u32>,
     /// Gather entries.
     pub gather_idx: Vec<u32>,
@@ -208,7 +211,8 @@ pub struct Model {
 
 /// Initial critical step of one element (s): L / c with L = V / A_max.
 pub fn initial_element_dt(x: &[[f64; 3]; 8], volume: f64, c: f64) -> f64 {
-    volume / max_face_area(x) / c
+    let xt = std::array::from_fn(|i| std::array::from_fn(|a| x[a][i]));
+    volume / max_face_area(&xt) / c
 }
 
 impl Model {
@@ -265,7 +269,7 @@ impl Model {
                 grad: Vec::with_capacity(n),
                 vol0: Vec::with_capacity(n),
                 gamma: Vec::new(),
-                hg_stiffness: Vec::new(),
+                hg_scale: Vec::new(),
                 gp_grad: Vec::new(),
                 gp_weight: Vec::new(),
                 history_stride: stride,
@@ -301,8 +305,9 @@ impl Model {
                                     bb += b * b;
                                 }
                             }
-                            g.hg_stiffness
-                                .push(hg.coefficient * lambda2mu * bb / (3.0 * geo.volume) / 64.0);
+                            g.hg_scale.push(hg.coefficient * lambda2mu * bb / (3.0 * geo.volume) / 64.0);
+                        } else {
+                            g.hg_scale.push(hg.coefficient * rho * geo.volume.powf(2.0 / 3.0) * 0.25);
                         }
                     }
                     Formulation::Full { .. } => {

@@ -184,6 +184,66 @@ fn write_frame(scene: &Scene, series: &mut Series) -> Result<(), String> {
         .map(|_| ())
 }
 
+/// Stop an unstable run: every law here is passive, so the internal energy (stored plus
+/// dissipated by the laws) cannot fall below zero; when the central-difference scheme goes
+/// unstable, the spurious high-frequency energy shows up as a large negative internal energy
+/// balanced by hourglass and bulk-viscous dissipation. Also stops on non-finite energies.
+fn check_stability(sim: &Simulation) -> Result<(), String> {
+    let e = &sim.energy;
+    let all = [
+        e.kinetic,
+        e.internal,
+        e.hourglass,
+        e.bulk_viscous,
+        e.damping,
+        e.contact,
+        e.external,
+    ];
+    if all.iter().any(|x| !x.is_finite()) {
+        return Err(format!(
+            "the energies became non-finite at t = {:.6} ms",
+            sim.time * 1e3
+        ));
+    }
+    let scale = all.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+    if e.internal < -0.05 * scale && scale > 0.0 {
+        let el = sim.dt_element;
+        return Err(format!(
+            "numerical instability at t = {:.6} ms: the internal energy became negative ({:.4e} J; hourglass {:.4e} J, bulk viscosity {:.4e} J, external work {:.4e} J). The step was set by element {el} (part {}); lower `run.dt_factor` (now {}) or use stiffness hourglass control",
+            sim.time * 1e3,
+            e.internal,
+            e.hourglass,
+            e.bulk_viscous,
+            e.external,
+            sim.part_of(el),
+            sim.settings.dt_factor
+        ));
+    }
+    Ok(())
+}
+
+/// Append the probe rows: time, the stages' history values (indenter force, depth, ...), then
+/// the maximum principal Cauchy stress (Pa) of each probed element; and the tensors.
+fn probe_rows(scene: &Scene, p: &mut History, pt: &mut History, row: &mut Vec<f64>) {
+    let sim = &scene.sim;
+    let (Some((_, els)), Some(stress)) = (&scene.output.probe, &sim.stress) else {
+        return;
+    };
+    row.clear();
+    row.push(sim.time);
+    for st in &sim.stages {
+        st.history_values(row);
+    }
+    let head = row.len();
+    row.extend(els.iter().map(|&e| principal(&stress[e as usize])[0]));
+    p.push(row);
+    row.truncate(head);
+    for &e in els {
+        row.extend(stress[e as usize]);
+    }
+    pt.push(row);
+}
+
 /// Run a scene, writing into `out`. `observer` is called every few steps and may update a
 /// progress bar. Returns the summary (also on failure, with the error in `status`) and the
 /// error if the run failed.
@@ -212,7 +272,25 @@ pub fn run_scene(
     let mut row = Vec::new();
     let end = scene.end_time;
     let hist_dt = scene.output.history_interval.max(0.0);
-    let vtk_dt = scene.output.vtk_interval;
+    let vtk_dt = scene.output.frame_interval;
+    let write_vtk = scene.output.vtk_interval.is_some();
+    let mut probe = scene.output.probe.as_ref().map(|(_, els)| {
+        let mut cols = vec!["time".to_string()];
+        for st in &scene.sim.stages {
+            cols.extend(st.history_columns());
+        }
+        let mut tcols = cols.clone();
+        cols.extend(els.iter().map(|e| format!("e{e}")));
+        for e in els {
+            for c in ["xx", "yy", "zz", "xy", "yz", "zx"] {
+                tcols.push(format!("e{e}_{c}"));
+            }
+        }
+        (
+            History::new(&out.join("probe.csv"), cols),
+            History::new(&out.join("probe_stress.csv"), tcols),
+        )
+    });
     let mut next_hist = 0.0;
     let mut next_vtk = 0.0;
     let mut max_err: f64 = 0.0;
@@ -236,10 +314,25 @@ pub fn run_scene(
             if t > 0.01 * end {
                 max_err = max_err.max(sim.energy.error());
             }
+            if let Err(e) = check_stability(sim) {
+                error = Some(format!("{}: {e}", scene.path.display()));
+                break;
+            }
         }
         if let Some(vdt) = vtk_dt {
             if t >= next_vtk * (1.0 - 1e-12) || done {
-                if let Err(e) = write_frame(scene, &mut series).and_then(|_| history.flush()) {
+                if let Some((p, pt)) = probe.as_mut() {
+                    probe_rows(scene, p, pt, &mut row);
+                }
+                let written = if write_vtk {
+                    write_frame(scene, &mut series)
+                } else {
+                    Ok(())
+                };
+                if let Err(e) = written.and_then(|_| history.flush()).and_then(|_| match &probe {
+                    Some((p, pt)) => p.flush().and_then(|_| pt.flush()),
+                    None => Ok(()),
+                }) {
                     error = Some(e);
                     break;
                 }
@@ -258,7 +351,7 @@ pub fn run_scene(
                 status = "converged".into();
                 history_row(&scene.sim, &reactions, &mut row);
                 history.push(&row);
-                if vtk_dt.is_some() {
+                if write_vtk {
                     let _ = write_frame(scene, &mut series);
                 }
                 break;
@@ -289,6 +382,11 @@ pub fn run_scene(
     }
     if let Err(e) = history.flush() {
         error.get_or_insert(e);
+    }
+    if let Some((p, pt)) = &probe {
+        if let Err(e) = p.flush().and_then(|_| pt.flush()) {
+            error.get_or_insert(e);
+        }
     }
     if let Some(e) = &error {
         status = format!("failed: {e}");

@@ -14,18 +14,17 @@
 //! Without F-bar: f_a = sum_gp w detJ P g_a.
 
 use super::{
-    add_nodal_forces, bulk_pressure, critical_step, deformation_gradient, sym6, ElementOut,
-    StepInput,
+    add_nodal_forces, bulk_pressure, cofactor, critical_step, deformation_gradient, gradient_rate, max_face_area, sym6,
+    ElementOut, Nodal, StepInput,
 };
-use crate::hex::max_face_area;
 use material::{Law, LawError, Mat3};
 
 /// Reference data of one fully integrated element.
 pub struct FullRef<'a> {
     /// Mean gradient [component][node] (1/m).
-    pub centre_grad: &'a [[f64; 8]; 3],
+    pub centre_grad: &'a Nodal,
     /// Gauss-point gradients.
-    pub gp_grad: &'a [[[f64; 8]; 3]; 8],
+    pub gp_grad: &'a [Nodal; 8],
     /// Gauss weights times det J (m^3).
     pub gp_weight: &'a [f64; 8],
     /// Reference volume (m^3).
@@ -39,13 +38,13 @@ pub fn compute_forces<L: Law>(
     law: &L,
     r: &FullRef,
     fbar: bool,
-    x: &[[f64; 3]; 8],
-    u: &[[f64; 3]; 8],
-    v: &[[f64; 3]; 8],
+    x: &Nodal,
+    u: &Nodal,
+    v: &Nodal,
     density_scale: f64,
     input: &StepInput,
     history: &mut [f64],
-    fe: &mut [[f64; 3]; 8],
+    fe: &mut Nodal,
 ) -> Result<ElementOut, LawError> {
     let hl = law.history_len();
     let f0 = deformation_gradient(u, r.centre_grad);
@@ -67,10 +66,9 @@ pub fn compute_forces<L: Law>(
     // Bulk viscosity from the centre rate of volume change.
     let mut trd = 0.0;
     if input.bulk.is_some() {
-        let fdot = deformation_gradient(v, r.centre_grad);
-        trd = fdot.component_mul(&f0it).sum();
+        trd = gradient_rate(v, r.centre_grad).component_mul(&f0it).sum();
     }
-    *fe = [[0.0; 3]; 8];
+    *fe = [[0.0; 8]; 3];
     let mut sig_acc = Mat3::zeros();
     let mut vol_acc = 0.0;
     for gp in 0..8 {
@@ -82,7 +80,7 @@ pub fn compute_forces<L: Law>(
             return Err(LawError::NonPositiveJacobian(j));
         }
         let h = &mut history[gp * hl..(gp + 1) * hl];
-        let fit = f.try_inverse().ok_or(LawError::NotFinite("F"))?.transpose();
+        let fit = cofactor(&f) / j;
         if fbar {
             let rr = (j0 / j).cbrt();
             let fb = f * rr;

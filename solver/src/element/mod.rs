@@ -134,29 +134,96 @@ pub struct ElementOut {
     pub failed: bool,
 }
 
+/// Eight nodal values of one component.
+pub type Vec8 = [f64; 8];
+/// Nodal vectors of one element in component-major order: `v[i][a]` is component i of node a.
+/// Kernels work on this layout so that the loops over the eight nodes vectorise.
+pub type Nodal = [Vec8; 3];
+
+/// sum_a x_a y_a, summed pairwise in a fixed order (so it vectorises and stays deterministic).
+#[inline(always)]
+pub fn dot8(x: &Vec8, y: &Vec8) -> f64 {
+    let mut t = [0.0; 4];
+    for k in 0..4 {
+        t[k] = x[k] * y[k] + x[k + 4] * y[k + 4];
+    }
+    (t[0] + t[1]) + (t[2] + t[3])
+}
+
 /// F = I + sum_a u_a (x) grad N_a.
 #[inline(always)]
-pub fn deformation_gradient(u: &[[f64; 3]; 8], g: &[[f64; 8]; 3]) -> Mat3 {
-    let mut f = Mat3::identity();
-    for a in 0..8 {
-        for i in 0..3 {
-            let ui = u[a][i];
-            f[(i, 0)] += ui * g[0][a];
-            f[(i, 1)] += ui * g[1][a];
-            f[(i, 2)] += ui * g[2][a];
-        }
-    }
-    f
+pub fn deformation_gradient(u: &Nodal, g: &Nodal) -> Mat3 {
+    Mat3::new(
+        1.0 + dot8(&u[0], &g[0]),
+        dot8(&u[0], &g[1]),
+        dot8(&u[0], &g[2]),
+        dot8(&u[1], &g[0]),
+        1.0 + dot8(&u[1], &g[1]),
+        dot8(&u[1], &g[2]),
+        dot8(&u[2], &g[0]),
+        dot8(&u[2], &g[1]),
+        1.0 + dot8(&u[2], &g[2]),
+    )
+}
+
+/// Rate of F: sum_a v_a (x) grad N_a.
+#[inline(always)]
+pub fn gradient_rate(v: &Nodal, g: &Nodal) -> Mat3 {
+    Mat3::new(
+        dot8(&v[0], &g[0]),
+        dot8(&v[0], &g[1]),
+        dot8(&v[0], &g[2]),
+        dot8(&v[1], &g[0]),
+        dot8(&v[1], &g[1]),
+        dot8(&v[1], &g[2]),
+        dot8(&v[2], &g[0]),
+        dot8(&v[2], &g[1]),
+        dot8(&v[2], &g[2]),
+    )
+}
+
+/// Cofactor matrix cof F = det(F) F^-T, without a division.
+#[inline(always)]
+pub fn cofactor(f: &Mat3) -> Mat3 {
+    let (a, b, c) = (f[(0, 0)], f[(0, 1)], f[(0, 2)]);
+    let (d, e, g) = (f[(1, 0)], f[(1, 1)], f[(1, 2)]);
+    let (h, i, k) = (f[(2, 0)], f[(2, 1)], f[(2, 2)]);
+    Mat3::new(
+        e * k - g * i,
+        g * h - d * k,
+        d * i - e * h,
+        c * i - b * k,
+        a * k - c * h,
+        b * h - a * i,
+        b * g - c * e,
+        c * d - a * g,
+        a * e - b * d,
+    )
 }
 
 /// fe_a += w * P grad N_a.
 #[inline(always)]
-pub fn add_nodal_forces(fe: &mut [[f64; 3]; 8], p: &Mat3, g: &[[f64; 8]; 3], w: f64) {
-    for a in 0..8 {
-        for i in 0..3 {
-            fe[a][i] += w * (p[(i, 0)] * g[0][a] + p[(i, 1)] * g[1][a] + p[(i, 2)] * g[2][a]);
+pub fn add_nodal_forces(fe: &mut Nodal, p: &Mat3, g: &Nodal, w: f64) {
+    for i in 0..3 {
+        let (p0, p1, p2) = (w * p[(i, 0)], w * p[(i, 1)], w * p[(i, 2)]);
+        for a in 0..8 {
+            fe[i][a] += p0 * g[0][a] + p1 * g[1][a] + p2 * g[2][a];
         }
     }
+}
+
+/// Largest face area of an element (m^2), from its current coordinates: each face's area is
+/// half the norm of the cross product of its diagonals (exact for planar quads).
+#[inline(always)]
+pub fn max_face_area(x: &Nodal) -> f64 {
+    let mut amax: f64 = 0.0;
+    for f in crate::mesh::FACES.iter() {
+        let d1 = [x[0][f[2]] - x[0][f[0]], x[1][f[2]] - x[1][f[0]], x[2][f[2]] - x[2][f[0]]];
+        let d2 = [x[0][f[3]] - x[0][f[1]], x[1][f[3]] - x[1][f[1]], x[2][f[3]] - x[2][f[1]]];
+        let c = [d1[1] * d2[2] - d1[2] * d2[1], d1[2] * d2[0] - d1[0] * d2[2], d1[0] * d2[1] - d1[1] * d2[0]];
+        amax = amax.max(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]);
+    }
+    0.5 * amax.sqrt()
 }
 
 /// Symmetric 3x3 to Voigt-like (xx yy zz xy yz zx).

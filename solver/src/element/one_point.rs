@@ -5,22 +5,22 @@
 //! qdot_ialpha = sum_a v_ia gamma_alpha,a (FB 1981 eq. 32).
 
 use super::{
-    add_nodal_forces, bulk_pressure, critical_step, deformation_gradient, sym6, ElementOut,
-    HourglassForm, StepInput,
+    add_nodal_forces, bulk_pressure, cofactor, critical_step, deformation_gradient, dot8, gradient_rate,
+    max_face_area, sym6, ElementOut, HourglassForm, Nodal, StepInput,
 };
-use crate::hex::max_face_area;
 use material::{Law, LawError};
 
 /// Reference data of one one-point element.
 pub struct OnePointRef<'a> {
     /// Mean gradient [component][node] (1/m).
-    pub grad: &'a [[f64; 8]; 3],
+    pub grad: &'a Nodal,
     /// Hourglass shape vectors.
     pub gamma: &'a [[f64; 8]; 4],
     /// Reference volume (m^3).
     pub vol0: f64,
-    /// Hourglass stiffness a_s (N/m), stiffness form only.
-    pub hg_stiffness: f64,
+    /// Hourglass scale: a_s (N/m) for the stiffness form; Q rho0 V0^(2/3) / 4 (kg/m) for the
+    /// viscous form, to be multiplied by the wave speed.
+    pub hg_scale: f64,
 }
 
 /// Internal forces of one element. `x` current coordinates, `u` displacements, `v` velocities
@@ -31,14 +31,13 @@ pub fn compute_forces<L: Law>(
     law: &L,
     r: &OnePointRef,
     hg_form: HourglassForm,
-    hg_q: f64,
-    x: &[[f64; 3]; 8],
-    u: &[[f64; 3]; 8],
-    v: &[[f64; 3]; 8],
+    x: &Nodal,
+    u: &Nodal,
+    v: &Nodal,
     density_scale: f64,
     input: &StepInput,
     history: &mut [f64],
-    fe: &mut [[f64; 3]; 8],
+    fe: &mut Nodal,
 ) -> Result<ElementOut, LawError> {
     let f = deformation_gradient(u, r.grad);
     let resp = law.evaluate(&f, input.dt, history)?;
@@ -48,70 +47,49 @@ pub fn compute_forces<L: Law>(
     let c = resp.wave_speed / density_scale.sqrt();
     let vol = j * r.vol0;
     let l = vol / max_face_area(x);
-    let mut out = ElementOut {
-        law_dissipation: resp.dissipation * r.vol0,
-        failed: resp.failed,
-        ..Default::default()
-    };
+    let mut out = ElementOut { law_dissipation: resp.dissipation * r.vol0, failed: resp.failed, ..Default::default() };
     let mut qterm = 0.0;
     let mut q = 0.0;
-    let fit = if input.bulk.is_some() || input.want_stress {
-        f.try_inverse().map(|m| m.transpose())
-    } else {
-        None
-    };
-    if let (Some(bv), Some(fit)) = (input.bulk.as_ref(), fit.as_ref()) {
-        let fdot = deformation_gradient(v, r.grad);
-        let trd = fdot.component_mul(fit).sum();
+    if let Some(bv) = input.bulk.as_ref() {
+        // tr D = Fdot : F^-T = Fdot : cof(F) / J.
+        let cof = cofactor(&f);
+        let trd = gradient_rate(v, r.grad).component_mul(&cof).sum() / j;
         let (qq, qt) = bulk_pressure(bv, trd, rho0 / j, l, resp.wave_speed);
         q = qq;
         qterm = qt;
         if q != 0.0 {
-            p -= fit * (q * j);
+            p -= cof * q;
             out.bulk_power = q * (-trd) * vol;
         }
     }
     out.dt = critical_step(l, c, qterm);
-    *fe = [[0.0; 3]; 8];
+    *fe = [[0.0; 8]; 3];
     add_nodal_forces(fe, &p, r.grad, r.vol0);
-    // Hourglass.
+    // Hourglass: generalised displacements (stiffness) or velocities (viscous) per mode.
+    let (a, w) = match hg_form {
+        HourglassForm::Viscous => (r.hg_scale * density_scale.sqrt() * c, v),
+        HourglassForm::Stiffness => (r.hg_scale, u),
+    };
+    let mut qq = [[0.0; 4]; 3];
+    let mut sumsq = 0.0;
+    for i in 0..3 {
+        for al in 0..4 {
+            let h = dot8(&w[i], &r.gamma[al]);
+            qq[i][al] = a * h;
+            sumsq += h * h;
+        }
+    }
+    for i in 0..3 {
+        for b in 0..8 {
+            fe[i][b] += qq[i][0] * r.gamma[0][b]
+                + qq[i][1] * r.gamma[1][b]
+                + qq[i][2] * r.gamma[2][b]
+                + qq[i][3] * r.gamma[3][b];
+        }
+    }
     match hg_form {
-        HourglassForm::Viscous => {
-            let a = hg_q * rho0 * density_scale * c * r.vol0.powf(2.0 / 3.0) * 0.25;
-            for al in 0..4 {
-                let g = &r.gamma[al];
-                let mut qd = [0.0; 3];
-                for b in 0..8 {
-                    for i in 0..3 {
-                        qd[i] += v[b][i] * g[b];
-                    }
-                }
-                out.hourglass_power += a * (qd[0] * qd[0] + qd[1] * qd[1] + qd[2] * qd[2]);
-                for b in 0..8 {
-                    for i in 0..3 {
-                        fe[b][i] += a * qd[i] * g[b];
-                    }
-                }
-            }
-        }
-        HourglassForm::Stiffness => {
-            let a = r.hg_stiffness;
-            for al in 0..4 {
-                let g = &r.gamma[al];
-                let mut qv = [0.0; 3];
-                for b in 0..8 {
-                    for i in 0..3 {
-                        qv[i] += u[b][i] * g[b];
-                    }
-                }
-                out.hourglass_stored += 0.5 * a * (qv[0] * qv[0] + qv[1] * qv[1] + qv[2] * qv[2]);
-                for b in 0..8 {
-                    for i in 0..3 {
-                        fe[b][i] += a * qv[i] * g[b];
-                    }
-                }
-            }
-        }
+        HourglassForm::Viscous => out.hourglass_power = a * sumsq,
+        HourglassForm::Stiffness => out.hourglass_stored = 0.5 * a * sumsq,
     }
     if input.want_stress {
         let mut sigma = f * resp.pk2 * f.transpose() / j;
@@ -120,7 +98,7 @@ pub fn compute_forces<L: Law>(
         sigma[(2, 2)] -= q;
         out.cauchy = sym6(&sigma);
     }
-    if !out.dt.is_finite() || !fe.iter().all(|r| r.iter().all(|x| x.is_finite())) {
+    if !(out.dt.is_finite() && fe.iter().all(|r| r.iter().all(|x| x.is_finite()))) {
         return Err(LawError::NotFinite("element force"));
     }
     Ok(out)

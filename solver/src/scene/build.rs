@@ -6,6 +6,9 @@ use crate::curve::Curve;
 use crate::element::{BulkViscosity, Formulation, Hourglass, HourglassForm};
 use crate::generate::{box_mesh, BoxSpec};
 use crate::mesh::Mesh;
+use crate::phantom::Phantom;
+use super::contact_spec::HandScene;
+use material::quantity::Length;
 use crate::model::{MassScaling, Model, Part};
 use crate::simulation::{DynamicRelaxation, LoopSettings, Simulation};
 use material::Material;
@@ -14,7 +17,8 @@ use std::path::{Path, PathBuf};
 /// What the output writer is asked for.
 #[derive(Clone, Debug)]
 pub struct OutputPlan {
-    /// Interval between VTK frames (s); None disables VTK output.
+    /// Interval between VTK frames (s); None disables VTK output (frames may still be taken
+    /// for the probe, see `frame_interval`).
     pub vtk_interval: Option<f64>,
     /// Interval between history rows (s).
     pub history_interval: f64,
@@ -22,6 +26,11 @@ pub struct OutputPlan {
     pub fields: Vec<String>,
     /// Node sets whose reactions are written: (name, nodes).
     pub reactions: Vec<(String, Vec<u32>)>,
+    /// Interval between frames (s): stress snapshots written to VTK and/or the probe files;
+    /// None when neither is written.
+    pub frame_interval: Option<f64>,
+    /// Element set sampled into `probe.csv` at every frame: (name, element ids).
+    pub probe: Option<(String, Vec<u32>)>,
 }
 
 impl OutputPlan {
@@ -47,6 +56,11 @@ pub struct Scene {
     pub title: String,
     /// Source file.
     pub path: PathBuf,
+    /// The phantom the mesh came from (its ROI, locations and skin faces; its `mesh` field is
+    /// emptied, the simulation owns the mesh), for `generator = "phantom"`.
+    pub phantom: Option<Phantom>,
+    /// Things the builder adjusted that the user should know (printed before the run).
+    pub notes: Vec<String>,
 }
 
 /// A scene error with its location.
@@ -121,8 +135,45 @@ pub fn curve<Q: Copy + Into<f64>>(c: &CurveSpec<Q>) -> Result<Curve, String> {
     Ok(cv)
 }
 
-fn read_mesh(spec: &MeshSpec, scene: &Path, src: &str) -> Result<Mesh, String> {
-    match (&spec.generator, &spec.file) {
+fn read_mesh(
+    spec: &MeshSpec,
+    scene: &Path,
+    src: &str,
+    prebuilt: Option<Phantom>,
+) -> Result<(Mesh, Option<Phantom>), String> {
+    if spec.phantom.is_some() && spec.generator.as_deref() != Some("phantom") {
+        return Err(err(
+            scene,
+            src,
+            "mesh.phantom",
+            Some("[mesh.phantom]"),
+            "`[mesh.phantom]` needs `generator = \"phantom\"`",
+        ));
+    }
+    if spec.generator.as_deref() == Some("phantom") {
+        if spec.file.is_some() {
+            return Err(err(
+                scene,
+                src,
+                "mesh.file",
+                Some("file"),
+                "give either `generator` or `file`, not both",
+            ));
+        }
+        let params = spec
+            .phantom
+            .clone()
+            .unwrap_or_default()
+            .to_params()
+            .map_err(|m| err(scene, src, "mesh.phantom", Some("[mesh.phantom]"), m))?;
+        let ph = match prebuilt {
+            Some(ph) if ph.params == params => ph,
+            _ => crate::phantom::build(&params)
+                .map_err(|m| err(scene, src, "mesh.phantom", Some("[mesh.phantom]"), m))?,
+        };
+        return Ok((ph.mesh.clone(), Some(ph)));
+    }
+    let mesh = match (&spec.generator, &spec.file) {
         (Some(g), None) if g == "box" => {
             let size = spec
                 .size
@@ -155,7 +206,7 @@ fn read_mesh(spec: &MeshSpec, scene: &Path, src: &str) -> Result<Mesh, String> {
             src,
             "mesh.generator",
             Some("generator"),
-            format!("unknown generator `{g}` (known: box)"),
+            format!("unknown generator `{g}` (known: box, phantom)"),
         )),
         (None, Some(f)) => {
             let p = scene.parent().unwrap_or(Path::new(".")).join(f);
@@ -169,7 +220,8 @@ fn read_mesh(spec: &MeshSpec, scene: &Path, src: &str) -> Result<Mesh, String> {
             Some("[mesh]"),
             "give either `generator = \"box\"` or `file = \"mesh.vtu\"`",
         )),
-    }
+    }?;
+    Ok((mesh, None))
 }
 
 fn formulation(p: &PartSpec) -> Result<Formulation, String> {
@@ -207,6 +259,17 @@ fn formulation(p: &PartSpec) -> Result<Formulation, String> {
 /// Build a scene from its parsed spec. `path` and `src` are used for error messages and to
 /// resolve relative file names.
 pub fn build_scene(spec: SceneSpec, path: &Path, src: &str) -> Result<Scene, String> {
+    build_scene_with(spec, path, src, None)
+}
+
+/// [`build_scene`], reusing an already built phantom when the scene's `[mesh.phantom]` asks
+/// for the same parameters (campaigns build the phantom once for all their runs).
+pub fn build_scene_with(
+    mut spec: SceneSpec,
+    path: &Path,
+    src: &str,
+    prebuilt: Option<Phantom>,
+) -> Result<Scene, String> {
     let e = |key: &str, needle: Option<&str>, msg: &dyn std::fmt::Display| {
         err(path, src, key, needle, msg)
     };
@@ -214,7 +277,7 @@ pub fn build_scene(spec: SceneSpec, path: &Path, src: &str) -> Result<Scene, Str
     if !(end_time > 0.0) {
         return Err(e("run.end_time", Some("end_time"), &"must be positive"));
     }
-    let dt_factor = spec.run.dt_factor.map(|x| x.0).unwrap_or(0.9);
+    let dt_factor = spec.run.dt_factor.map(|x| x.0).unwrap_or(crate::simulation::DEFAULT_DT_FACTOR);
     if !(dt_factor > 0.0 && dt_factor <= 1.0) {
         return Err(e(
             "run.dt_factor",
@@ -222,7 +285,15 @@ pub fn build_scene(spec: SceneSpec, path: &Path, src: &str) -> Result<Scene, Str
             &format!("must lie in (0, 1], got {dt_factor}"),
         ));
     }
-    let mut mesh = read_mesh(&spec.mesh, path, src)?;
+    let (mut mesh, mut phantom) = read_mesh(&spec.mesh, path, src, prebuilt)?;
+    for (i, h) in spec.hands.iter_mut().enumerate() {
+        place_hand(h, phantom.as_ref())
+            .map_err(|m| e(&format!("hand[{i}]"), Some(&format!("\"{}\"", h.name)), &m))?;
+    }
+    if let Some(ph) = phantom.as_mut() {
+        // the scene owns the mesh from here on; keep the phantom's other data
+        ph.mesh = Mesh::default();
+    }
     // Node sets.
     for (name, ns) in &spec.node_sets {
         let key = format!("node_sets.{name}");
@@ -486,11 +557,31 @@ pub fn build_scene(spec: SceneSpec, path: &Path, src: &str) -> Result<Scene, Str
         .history_interval
         .map(|t| t.0)
         .unwrap_or(end_time / 500.0);
+    let probe = match &out.probe {
+        None => None,
+        Some(name) => {
+            let els = mesh.element_sets.get(name).cloned().ok_or_else(|| {
+                let known: Vec<&String> = mesh.element_sets.keys().collect();
+                e(
+                    "output.probe",
+                    Some("probe"),
+                    &format!("no element set `{name}`; known: {known:?}"),
+                )
+            })?;
+            Some((name.clone(), els))
+        }
+    };
+    let frame_interval = out.interval.map(|t| t.0).unwrap_or(end_time / 10.0);
+    if !(frame_interval > 0.0) {
+        return Err(e("output.interval", Some("interval"), &"must be positive"));
+    }
     let plan = OutputPlan {
         vtk_interval,
+        frame_interval: (vtk_interval.is_some() || probe.is_some()).then_some(frame_interval),
         history_interval,
         fields,
         reactions,
+        probe,
     };
     // Settings.
     let bulk = match &spec.bulk_viscosity {
@@ -536,9 +627,23 @@ pub fn build_scene(spec: SceneSpec, path: &Path, src: &str) -> Result<Scene, Str
         dt_max: spec.run.dt_max.map(|t| t.0).unwrap_or(f64::INFINITY),
         dt_min: spec.run.dt_min.map(|t| t.0).unwrap_or(1e-6 * dt0),
     };
-    let want_stress = plan.needs_stress();
-    let sim = Simulation::new(model, settings, constraints, loads, v0, want_stress)
+    let want_stress = plan.needs_stress() || plan.probe.is_some();
+    let mut sim = Simulation::new(model, settings, constraints, loads, v0, want_stress)
         .map_err(|m| format!("{}: {m}", path.display()))?;
+    let mut notes = Vec::new();
+    // Contact exists only when the scene has indenters or hands.
+    if !spec.indenters.is_empty() || !spec.hands.is_empty() {
+        let stage = crate::contact_stage::build_stage(
+            &sim,
+            &spec.indenters,
+            &spec.hands,
+            spec.contact.as_ref(),
+            path,
+            src,
+            &mut notes,
+        )?;
+        sim.stages.push(Box::new(stage));
+    }
     Ok(Scene {
         sim,
         end_time,
@@ -549,7 +654,36 @@ pub fn build_scene(spec: SceneSpec, path: &Path, src: &str) -> Result<Scene, Str
                 .unwrap_or_default()
         }),
         path: path.to_path_buf(),
+        phantom,
+        notes,
     })
+}
+
+/// Place a hand by a phantom location (`location` or `at`): its point is the skin point there
+/// and its direction the inward skin normal, unless the scene gives `direction` itself.
+fn place_hand(h: &mut HandScene, phantom: Option<&Phantom>) -> Result<(), String> {
+    let loc = match (&h.location, &h.at) {
+        (None, None) => return Ok(()),
+        (Some(_), Some(_)) => return Err("give `location` or `at`, not both".into()),
+        _ if h.point.is_some() => {
+            return Err("give `point`, or `location`/`at`, not both".into());
+        }
+        (Some(name), None) => {
+            let ph = phantom.ok_or("`location` needs a phantom mesh (`generator = \"phantom\"`)")?;
+            ph.locations.get(name).cloned().ok_or_else(|| {
+                format!("no palpation location `{name}` (A, B, C, P01..P25)")
+            })?
+        }
+        (None, Some(xy)) => {
+            let ph = phantom.ok_or("`at` needs a phantom mesh (`generator = \"phantom\"`)")?;
+            crate::phantom::location_at(&ph.mesh, &ph.skin_faces, &ph.volume, "at", xy[0].0, xy[1].0)?
+        }
+    };
+    h.point = Some(loc.surface.map(Length));
+    if h.direction.is_none() {
+        h.direction = Some(loc.inward_normal);
+    }
+    Ok(())
 }
 
 fn scale_curve(c: &mut Curve, s: f64) {

@@ -6,6 +6,7 @@
 
 pub mod build;
 pub mod contact_spec;
+pub mod phantom_spec;
 pub mod spec;
 
 pub use build::{load_scene, Scene};

@@ -62,7 +62,7 @@ pub struct SceneSpec {
 pub struct RunSpec {
     /// End time.
     pub end_time: Time,
-    /// Time-step safety factor (default 0.9).
+    /// Time-step safety factor (default 0.75, see [`crate::simulation::DEFAULT_DT_FACTOR`]).
     pub dt_factor: Option<Number>,
     /// Largest step.
     pub dt_max: Option<Time>,
@@ -94,6 +94,8 @@ pub struct MeshSpec {
     pub seed: Option<u64>,
     /// Box: its part name (default `body`).
     pub part: Option<String>,
+    /// Phantom: `[mesh.phantom]` (with `generator = "phantom"`).
+    pub phantom: Option<super::phantom_spec::PhantomScene>,
 }
 
 /// `[[part]]`.
@@ -278,4 +280,7 @@ pub struct OutputSpec {
     pub fields: Option<Vec<String>>,
     /// Node sets whose reaction forces go into history.csv.
     pub reactions: Option<Vec<String>>,
+    /// An element set (e.g. the phantom's `roi`) whose stresses are sampled at every frame
+    /// time into `probe.csv` (maximum principal stress) and `probe_stress.csv` (tensors).
+    pub probe: Option<String>,
 }

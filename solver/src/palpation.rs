@@ -1,0 +1,336 @@
+//! One two-finger palpation of the abdomen phantom, as the reference study ran it
+//! (`shared/reference/paper-facts.md`): the reduced phantom, the paper's three tissues
+//! (`paper:liver`, `paper:flesh`, `paper:ribs`), two rigid capsule fingers pressed 15 mm along
+//! the inward skin normal in 25 ms with a smooth ramp, penalty contact on the anterior skin,
+//! the back fixed and rollers on the cut planes, and the ROI's stresses sampled every 5 ms.
+//!
+//! [`PalpationSetup::scene_toml`] writes this as an ordinary scene file, so that a palpation is
+//! a scene like any other: `palpa palpate` saves it as `scene.toml` in its output directory,
+//! and `palpa run` on that file repeats the run exactly. Campaigns and the accuracy study
+//! vary its fields. [`read_probe`] reads the ROI samples back.
+//!
+//! Materials of the other phantom parts: the lumped viscera are given the flesh law (the
+//! paper's "lumped abdominal tissue"), the spine the rib law (its nodes are fixed anyway), and
+//! a tumour the liver law with its shear and Prony moduli scaled by the tumour's stiffness
+//! factor (so its Poisson ratio and relaxation times stay the liver's).
+
+use crate::output::history::{column, read_history};
+use crate::phantom::{DEFAULT_VOXEL, PAPER_VOXEL};
+use std::fmt::Write;
+use std::path::Path;
+
+/// Where the fingers press.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Place {
+    /// A named phantom location: "A", "B", "C", "P01".."P25".
+    Named(String),
+    /// A point (x, y) of the body surface (m).
+    At(f64, f64),
+}
+
+/// Element formulation of every part.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ElementChoice {
+    /// One-point integration with viscous hourglass control (the default, as LS-DYNA's type 1).
+    OnePointViscous,
+    /// One-point integration with stiffness hourglass control.
+    OnePointStiffness,
+    /// Fully integrated 2x2x2 with F-bar.
+    FullFbar,
+}
+
+impl ElementChoice {
+    /// Scene keys of the choice.
+    fn scene_keys(&self) -> &'static str {
+        match self {
+            ElementChoice::OnePointViscous => "formulation = \"one_point\", hourglass = \"viscous\"",
+            ElementChoice::OnePointStiffness => {
+                "formulation = \"one_point\", hourglass = \"stiffness\""
+            }
+            ElementChoice::FullFbar => "formulation = \"full_fbar\"",
+        }
+    }
+    /// Short name for tables.
+    pub fn label(&self) -> &'static str {
+        match self {
+            ElementChoice::OnePointViscous => "1pt-viscous",
+            ElementChoice::OnePointStiffness => "1pt-stiffness",
+            ElementChoice::FullFbar => "full-fbar",
+        }
+    }
+}
+
+impl std::str::FromStr for ElementChoice {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s {
+            "one_point" | "1pt-viscous" | "viscous" => Ok(ElementChoice::OnePointViscous),
+            "1pt-stiffness" | "stiffness" => Ok(ElementChoice::OnePointStiffness),
+            "full_fbar" | "full-fbar" | "full" => Ok(ElementChoice::FullFbar),
+            o => Err(format!(
+                "unknown element formulation `{o}` (one_point, stiffness, full_fbar)"
+            )),
+        }
+    }
+}
+
+/// A liver tumour (SI).
+#[derive(Clone, Debug, PartialEq)]
+pub struct TumourSetup {
+    /// Centre (m).
+    pub center: [f64; 3],
+    /// Radius (m).
+    pub radius: f64,
+    /// Stiffness relative to healthy liver.
+    pub stiffness: f64,
+}
+
+/// Everything that defines one palpation. Lengths in m, times in s.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PalpationSetup {
+    /// Title of the run.
+    pub title: String,
+    /// `reduced` or `full`.
+    pub variant: String,
+    /// Voxel edge (m).
+    pub voxel: f64,
+    /// Subcutaneous fat (m).
+    pub fat_thickness: f64,
+    /// Respiratory phase 0..1.
+    pub respiratory_phase: f64,
+    /// Tumours.
+    pub tumours: Vec<TumourSetup>,
+    /// Where the fingers press.
+    pub place: Place,
+    /// Indentation depth (m).
+    pub depth: f64,
+    /// Time to reach the depth (s); the run ends then.
+    pub duration: f64,
+    /// Interval between stress samples and VTK frames (s).
+    pub sample_interval: f64,
+    /// Finger diameter (m).
+    pub finger_diameter: f64,
+    /// Centre-to-centre finger spacing (m).
+    pub finger_spacing: f64,
+    /// Element formulation.
+    pub element: ElementChoice,
+    /// Selective mass scaling to this step (s), if any.
+    pub mass_scaling_dt: Option<f64>,
+    /// Largest mass that mass scaling may add, as a fraction of the physical mass.
+    pub mass_scaling_limit: f64,
+    /// Time-step safety factor.
+    pub dt_factor: f64,
+    /// Write VTK frames.
+    pub vtk: bool,
+}
+
+impl Default for PalpationSetup {
+    /// The paper's protocol on the default (coarse) reduced phantom at location A.
+    fn default() -> Self {
+        PalpationSetup {
+            title: "palpation".into(),
+            variant: "reduced".into(),
+            voxel: DEFAULT_VOXEL,
+            fat_thickness: 0.015,
+            respiratory_phase: 0.0,
+            tumours: Vec::new(),
+            place: Place::Named("A".into()),
+            depth: 0.015,
+            duration: 0.025,
+            sample_interval: 0.005,
+            finger_diameter: 0.015,
+            finger_spacing: 0.020,
+            element: ElementChoice::OnePointViscous,
+            mass_scaling_dt: None,
+            mass_scaling_limit: 0.05,
+            dt_factor: crate::simulation::DEFAULT_DT_FACTOR,
+            vtk: true,
+        }
+    }
+}
+
+/// The liver card in SI with its moduli scaled by `s` (see the module doc).
+fn scaled_liver_card(s: f64) -> String {
+    let mu = [89.14, 9.965, -92.75].map(|m| m * s);
+    let g = [6970.1, 58327.0, 35291.0].map(|m| m * s);
+    format!(
+        "law = \"ogden\"\ndensity = \"1050 kg/m^3\"\nmu = [\"{} Pa\", \"{} Pa\", \"{} Pa\"]\n\
+         alpha = [1.0, 19.0656, -10.9604]\npoisson_ratio = 0.49\nprony = [\n  \
+         {{ modulus = \"{} Pa\", tau = \"10 ms\" }},\n  {{ modulus = \"{} Pa\", tau = \"100 ms\" }},\n  \
+         {{ modulus = \"{} Pa\", tau = \"1000 ms\" }},\n]\nprony_on = \"green_lagrange\"\n",
+        mu[0], mu[1], mu[2], g[0], g[1], g[2]
+    )
+}
+
+impl PalpationSetup {
+    /// The paper's protocol at the paper-like resolution (3 mm voxels, about 105k hexahedra).
+    pub fn paper_resolution() -> Self {
+        PalpationSetup {
+            voxel: PAPER_VOXEL,
+            ..Default::default()
+        }
+    }
+
+    /// Check the values a user can set.
+    pub fn validate(&self) -> Result<(), String> {
+        let pos = |v: f64, what: &str| {
+            if v > 0.0 && v.is_finite() {
+                Ok(())
+            } else {
+                Err(format!("{what} must be positive, got {v}"))
+            }
+        };
+        pos(self.depth, "depth")?;
+        pos(self.duration, "duration")?;
+        pos(self.sample_interval, "sample interval")?;
+        pos(self.finger_diameter, "finger diameter")?;
+        pos(self.finger_spacing, "finger spacing")?;
+        pos(self.voxel, "voxel")?;
+        if self.finger_spacing < self.finger_diameter {
+            return Err("the finger spacing (centre to centre) must be at least the diameter".into());
+        }
+        if !(self.dt_factor > 0.0 && self.dt_factor <= 1.0) {
+            return Err(format!("dt factor must lie in (0, 1], got {}", self.dt_factor));
+        }
+        if let Some(t) = self.mass_scaling_dt {
+            pos(t, "mass-scaling target step")?;
+        }
+        Ok(())
+    }
+
+    /// The scene file text. Every quantity is written in SI with its unit.
+    pub fn scene_toml(&self) -> String {
+        let mut s = String::new();
+        let _ = writeln!(
+            s,
+            "# A two-finger palpation of the built-in abdomen phantom, written by palpa.\n\
+             # Run it again with `palpa run scene.toml --out DIR`.\n"
+        );
+        let _ = writeln!(
+            s,
+            "[run]\ntitle = {:?}\nend_time = \"{} s\"\ndt_factor = {}\n",
+            self.title, self.duration, self.dt_factor
+        );
+        let _ = writeln!(
+            s,
+            "[mesh]\ngenerator = \"phantom\"\n\n[mesh.phantom]\nvariant = {:?}\nvoxel = \"{} m\"\n\
+             fat_thickness = \"{} m\"\nrespiratory_phase = {}",
+            self.variant, self.voxel, self.fat_thickness, self.respiratory_phase
+        );
+        if !self.tumours.is_empty() {
+            s.push_str("tumours = [\n");
+            for t in &self.tumours {
+                let _ = writeln!(
+                    s,
+                    "  {{ center = [\"{} m\", \"{} m\", \"{} m\"], radius = \"{} m\", stiffness = {} }},",
+                    t.center[0], t.center[1], t.center[2], t.radius, t.stiffness
+                );
+            }
+            s.push_str("]\n");
+        }
+        s.push('\n');
+        let el = self.element.scene_keys();
+        let parts = [
+            ("flesh", "paper:flesh"),
+            ("liver", "paper:liver"),
+            ("ribs", "paper:ribs"),
+            ("viscera", "paper:flesh"),
+            ("spine", "paper:ribs"),
+        ];
+        let tumour_names: Vec<String> = (0..self.tumours.len())
+            .map(|n| {
+                if n == 0 {
+                    "tumour".into()
+                } else {
+                    format!("tumour{}", n + 1)
+                }
+            })
+            .collect();
+        for (n, t) in tumour_names.iter().zip(&self.tumours) {
+            let _ = writeln!(s, "[materials.{n}]\n{}", scaled_liver_card(t.stiffness));
+        }
+        for (p, m) in &parts {
+            let _ = writeln!(s, "[[part]]\nname = {p:?}\nmaterial = {m:?}\n{}\n", el.replace(", ", "\n"));
+        }
+        for n in &tumour_names {
+            let _ = writeln!(s, "[[part]]\nname = {n:?}\nmaterial = {n:?}\n{}\n", el.replace(", ", "\n"));
+        }
+        s.push_str("[[boundary]]\nnodes = \"back\"\nfix = [\"all\"]\n\n");
+        let rollers: &[(&str, &str)] = if self.variant == "full" {
+            &[("cut_ymin", "y"), ("cut_ymax", "y")]
+        } else {
+            &[("cut_xmax", "x"), ("cut_ymin", "y"), ("cut_ymax", "y")]
+        };
+        for (set, ax) in rollers {
+            let _ = writeln!(s, "[[boundary]]\nnodes = {set:?}\nfix = [{ax:?}]\n");
+        }
+        if let Some(t) = self.mass_scaling_dt {
+            let _ = writeln!(
+                s,
+                "[mass_scaling]\ntarget_dt = \"{t} s\"\nmax_added = {}\n",
+                self.mass_scaling_limit
+            );
+        }
+        let place = match &self.place {
+            Place::Named(n) => format!("location = {n:?}"),
+            Place::At(x, y) => format!("at = [\"{x} m\", \"{y} m\"]"),
+        };
+        let _ = writeln!(
+            s,
+            "[[hand]]\nname = \"hand\"\n{place}\ndiameter = \"{} m\"\nspacing = \"{} m\"\n\
+             length = \"0.06 m\"\nmotion = {{ kind = \"displacement\", curve = {{ kind = \"smooth_step\", \
+             value = \"{} m\", end = \"{} s\" }} }}\n",
+            self.finger_diameter, self.finger_spacing, self.depth, self.duration
+        );
+        s.push_str("[contact]\nsurface = \"skin\"\n\n");
+        let _ = writeln!(
+            s,
+            "[output]\ninterval = \"{} s\"\nvtk = {}\nfields = [\"displacement\", \"part\", \"von_mises\", \"max_principal\"]\nprobe = \"roi\"",
+            self.sample_interval, self.vtk
+        );
+        s
+    }
+}
+
+/// The ROI samples of a finished run (`probe.csv`).
+#[derive(Clone, Debug, Default)]
+pub struct ProbeSamples {
+    /// Sample times (s).
+    pub time: Vec<f64>,
+    /// Hand force along the pressing direction (N) at each sample (`hand_reaction`).
+    pub force: Vec<f64>,
+    /// Hand travel along the pressing direction (m) at each sample (`hand_travel`): the
+    /// indentation, as the fingers start on the skin.
+    pub depth: Vec<f64>,
+    /// ROI element ids.
+    pub elements: Vec<u32>,
+    /// Maximum principal Cauchy stress (Pa), one row per sample, one column per ROI element.
+    pub stress: Vec<Vec<f64>>,
+}
+
+/// Read `probe.csv` of a run directory whose hand is named `hand`.
+pub fn read_probe(dir: &Path, hand: &str) -> Result<ProbeSamples, String> {
+    let (cols, rows) = read_history(&dir.join("probe.csv"))?;
+    let get = |name: &str| {
+        column(&cols, &rows, name)
+            .ok_or_else(|| format!("{}: no column `{name}`", dir.join("probe.csv").display()))
+    };
+    let time = get("time")?;
+    let force = get(&format!("{hand}_reaction"))?;
+    let depth = get(&format!("{hand}_travel"))?;
+    let idx: Vec<(usize, u32)> = cols
+        .iter()
+        .enumerate()
+        .filter_map(|(i, c)| c.strip_prefix('e').and_then(|n| n.parse().ok()).map(|e| (i, e)))
+        .collect();
+    Ok(ProbeSamples {
+        time,
+        force,
+        depth,
+        elements: idx.iter().map(|x| x.1).collect(),
+        stress: rows
+            .iter()
+            .map(|r| idx.iter().map(|&(i, _)| r[i]).collect())
+            .collect(),
+    })
+}

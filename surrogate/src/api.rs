@@ -1,0 +1,284 @@
+//! The functions the `palpa train`, `palpa predict` and `palpa evaluate` commands call.
+
+use crate::dataset::Dataset;
+use crate::error::{Error, Result};
+use crate::fit::{compute_fit, compute_fit_by_location};
+use crate::gp::{fit_gp, GpOptions};
+use crate::mlp::{train_mlp, MlpOptions};
+use crate::model::{ModelKind, Predictor, PredictorImpl, TrainedModel};
+use crate::report::{CostRow, EvaluationReport, LocationFit, TrainReport};
+use ndarray::{s, Array2, Axis};
+use serde::{Deserialize, Serialize};
+use std::path::Path;
+use std::time::Instant;
+
+/// Settings of both model families; `train` uses the one its `ModelKind` names.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct TrainOptions {
+    /// MLP settings.
+    pub mlp: MlpOptions,
+    /// GP settings.
+    pub gp: GpOptions,
+}
+
+/// One prediction: ROI stress and, for a GP, its variance.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Prediction {
+    /// ROI maximum principal stress [Pa], one per ROI element.
+    pub stress: Vec<f64>,
+    /// GP predictive variance [Pa^2] (shared by all ROI elements); `None` for an MLP.
+    pub variance: Option<f64>,
+}
+
+/// A named model configuration for `evaluate`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ModelConfig {
+    /// Name in the table.
+    pub name: String,
+    /// Family.
+    pub kind: ModelKind,
+    /// Settings.
+    pub options: TrainOptions,
+}
+
+/// Reads the dataset at `dataset` (see `Dataset::read`), trains a `kind` model on its split-0
+/// samples, scores it on its split-1 samples, saves it at `out` (see `model::model_paths`) and
+/// returns the report (Fit per test location and overall, training time, latency).
+pub fn train(
+    dataset: &Path,
+    kind: ModelKind,
+    opts: &TrainOptions,
+    out: &Path,
+) -> Result<TrainReport> {
+    let data = Dataset::read(dataset)?;
+    let (model, report) = train_model(&data, kind, opts)?;
+    model.save(
+        out,
+        data.roi_ids.as_slice().unwrap_or(&data.roi_ids.to_vec()),
+        data.roi_centroids.view(),
+        &report,
+    )?;
+    Ok(report)
+}
+
+/// One-shot prediction with the model saved at `model` for a finger at (`x`, `y`) [m] pressing
+/// with `force` [N]. For a stream of inputs, load a [`Predictor`] once instead.
+pub fn predict(model: &Path, x: f64, y: f64, force: f64) -> Result<Prediction> {
+    for (name, v) in [("x", x), ("y", y), ("force", force)] {
+        if !v.is_finite() {
+            return Err(Error::invalid(name, format!("{v} is not a finite number")));
+        }
+    }
+    let mut p = Predictor::load(model)?;
+    let (stress, variance) = p.predict_with_variance(x, y, force);
+    Ok(Prediction {
+        stress: stress.to_vec(),
+        variance,
+    })
+}
+
+/// Trains a `kind` model on `data`'s split-0 samples and scores it on its split-1 samples.
+pub fn train_model(
+    data: &Dataset,
+    kind: ModelKind,
+    opts: &TrainOptions,
+) -> Result<(TrainedModel, TrainReport)> {
+    let (model, report, _) = fit_and_score(data, kind, opts)?;
+    Ok((model, report))
+}
+
+/// Leave-one-location-out cross-validation of each configuration over every location of `data`
+/// (both splits): for each location, train on all the others and predict it. Returns the
+/// accuracy-versus-cost table. Cost: (number of locations) x (configurations) trainings.
+pub fn evaluate(data: &Dataset, configs: &[ModelConfig]) -> Result<EvaluationReport> {
+    data.validate()?;
+    let mut locations: Vec<i64> = data.location.to_vec();
+    locations.sort_unstable();
+    locations.dedup();
+    if locations.len() < 2 {
+        return Err(Error::invalid(
+            "location",
+            "cross-validation needs at least 2 locations",
+        ));
+    }
+    let mut rows = Vec::new();
+    for cfg in configs {
+        let mut y_all = Vec::new();
+        let mut yhat_all = Vec::new();
+        let mut by_location = Vec::new();
+        let (mut secs, mut lat) = (0.0, 0.0);
+        let (mut size, mut n_params) = (String::new(), 0);
+        for &loc in &locations {
+            let mut fold = data.clone();
+            fold.split = data.location.mapv(|l| u8::from(l == loc));
+            let (_, report, yhat) = fit_and_score(&fold, cfg.kind, &cfg.options)?;
+            let rows_l: Vec<usize> = (0..data.n_samples())
+                .filter(|&i| data.location[i] == loc)
+                .collect();
+            y_all.push(data.y.select(Axis(0), &rows_l));
+            yhat_all.push(yhat.select(Axis(0), &rows_l));
+            by_location.extend(report.test_fit_by_location.clone());
+            secs += report.train_seconds;
+            lat += report.latency_us;
+            size = report.size.clone();
+            n_params = report.n_params;
+        }
+        let cat = |v: &[Array2<f64>]| {
+            let views: Vec<_> = v.iter().map(|a| a.view()).collect();
+            ndarray::concatenate(Axis(0), &views)
+                .map_err(|e| Error::numerical("evaluate", e.to_string()))
+        };
+        let (y, yhat) = (cat(&y_all)?, cat(&yhat_all)?);
+        let fits: Vec<f64> = by_location.iter().map(|l| l.fit).collect();
+        let k = locations.len() as f64;
+        rows.push(CostRow {
+            name: cfg.name.clone(),
+            kind: cfg.kind,
+            size,
+            n_params,
+            fit_pooled: compute_fit(y.view(), yhat.view()),
+            fit_mean: fits.iter().sum::<f64>() / fits.len().max(1) as f64,
+            fit_min: fits.iter().copied().fold(f64::INFINITY, f64::min),
+            train_seconds: secs / k,
+            latency_us: lat / k,
+            by_location,
+        });
+    }
+    Ok(EvaluationReport {
+        n_folds: locations.len(),
+        rows,
+    })
+}
+
+/// The default table of `evaluate`: the GP, the paper's MLP, and two smaller MLPs, all trained
+/// with Adam for `mlp_epochs` epochs.
+pub fn default_evaluation_configs(mlp_epochs: usize) -> Vec<ModelConfig> {
+    let mlp = |name: &str, hidden: &[usize]| ModelConfig {
+        name: name.into(),
+        kind: ModelKind::Mlp,
+        options: TrainOptions {
+            mlp: MlpOptions {
+                hidden: hidden.to_vec(),
+                epochs: mlp_epochs,
+                ..Default::default()
+            },
+            gp: GpOptions::default(),
+        },
+    };
+    vec![
+        ModelConfig {
+            name: "gp".into(),
+            kind: ModelKind::Gp,
+            options: TrainOptions::default(),
+        },
+        mlp("mlp-paper", &crate::mlp::PAPER_HIDDEN),
+        mlp("mlp-medium", &[32, 64, 128]),
+        mlp("mlp-small", &[16, 32]),
+    ]
+}
+
+/// Trains, predicts every row of `data`, and scores. Returns the predictions too (n x R, Pa).
+fn fit_and_score(
+    data: &Dataset,
+    kind: ModelKind,
+    opts: &TrainOptions,
+) -> Result<(TrainedModel, TrainReport, Array2<f64>)> {
+    data.validate()?;
+    let train_rows = data.rows_with_split(0);
+    let test_rows = data.rows_with_split(1);
+    if train_rows.is_empty() {
+        return Err(Error::invalid("split", "no training samples (split == 0)"));
+    }
+    let x3 = data.x.slice(s![.., 0..3]);
+    let xt = x3.select(Axis(0), &train_rows);
+    let yt = data.y.select(Axis(0), &train_rows);
+    let start = Instant::now();
+    let (model, epochs, objective, size, n_params, settings) = match kind {
+        ModelKind::Mlp => {
+            let m = train_mlp(xt.view(), yt.view(), &opts.mlp)?;
+            let size = m
+                .params
+                .sizes
+                .iter()
+                .map(|s| s.to_string())
+                .collect::<Vec<_>>()
+                .join("-");
+            let (e, l, np) = (m.epochs_run, m.final_loss, m.params.n_params());
+            let set = serde_json::to_value(&opts.mlp).unwrap_or_default();
+            (TrainedModel::Mlp(m), Some(e), l, size, np, set)
+        }
+        ModelKind::Gp => {
+            let g = fit_gp(xt.view(), yt.view(), &opts.gp)?;
+            let size = format!("SE-ARD, n={}", g.train_inputs.nrows());
+            let (l, np) = (g.log_marginal_likelihood, g.alpha.len());
+            let set = serde_json::to_value(&opts.gp).unwrap_or_default();
+            (TrainedModel::Gp(g), None, l, size, np, set)
+        }
+    };
+    let train_seconds = start.elapsed().as_secs_f64();
+    let mut pred = model.to_predictor();
+    let mut yhat = Array2::zeros(data.y.dim());
+    for (i, mut row) in yhat.rows_mut().into_iter().enumerate() {
+        let xi = [x3[(i, 0)], x3[(i, 1)], x3[(i, 2)]];
+        row.assign(&ndarray::ArrayView1::from(pred.predict_inputs(&xi)));
+    }
+    let latency_us = measure_latency(&mut pred, &x3.select(Axis(0), &train_rows));
+    let score = |rows: &[usize]| {
+        compute_fit(
+            data.y.select(Axis(0), rows).view(),
+            yhat.select(Axis(0), rows).view(),
+        )
+    };
+    let train_fit = score(&train_rows);
+    let (test_fit, test_fit_by_location) = if test_rows.is_empty() {
+        (None, Vec::new())
+    } else {
+        let loc: Vec<i64> = test_rows.iter().map(|&i| data.location[i]).collect();
+        let by = compute_fit_by_location(
+            data.y.select(Axis(0), &test_rows).view(),
+            yhat.select(Axis(0), &test_rows).view(),
+            &loc,
+        )
+        .into_iter()
+        .map(|(location, fit)| LocationFit {
+            location,
+            label: data.location_label(location),
+            n_samples: loc.iter().filter(|&&l| l == location).count(),
+            fit,
+        })
+        .collect();
+        (Some(score(&test_rows)), by)
+    };
+    let report = TrainReport {
+        kind,
+        size,
+        n_params,
+        n_train: train_rows.len(),
+        n_test: test_rows.len(),
+        train_seconds,
+        epochs,
+        final_objective: objective,
+        train_fit,
+        test_fit,
+        test_fit_by_location,
+        latency_us,
+        settings,
+    };
+    Ok((model, report, yhat))
+}
+
+/// Mean latency [us] of one prediction over the rows of `inputs`, cycled for at least 2000 calls.
+fn measure_latency(pred: &mut PredictorImpl, inputs: &Array2<f64>) -> f64 {
+    let n = inputs.nrows().max(1);
+    let calls = 2000usize;
+    let start = Instant::now();
+    let mut sink = 0.0;
+    for k in 0..calls {
+        let i = k % n;
+        let xi = [inputs[(i, 0)], inputs[(i, 1)], inputs[(i, 2)]];
+        sink += pred.predict_inputs(&xi).first().copied().unwrap_or(0.0);
+    }
+    std::hint::black_box(sink);
+    start.elapsed().as_secs_f64() * 1e6 / calls as f64
+}

@@ -1,0 +1,102 @@
+//! Allocation-free GP prediction over a fitted model.
+//!
+//! ```text
+//! k*_i  = s2 exp(-1/2 sum_d ((u_d - u_i,d) / l_d)^2)        i = 1..n
+//! mean  = mu_y + s_y * (A^T k*)                              A = K^-1 V, n x R
+//! var   = s_y^2 * (s2 - k*^T K^-1 k*)                        latent (noise-free) variance
+//! ```
+//!
+//! The variance is the same for every ROI element: the kernel and the output scale `s_y` are
+//! shared by all outputs (see `normalise`). Units: mean in Pa, variance in Pa^2.
+//! Source: Rasmussen and Williams 2006, eqs. (2.25)-(2.26).
+
+use super::kernel::SeArd;
+use crate::kernels::accumulate_rows;
+use crate::normalise::Scaling;
+
+/// Reusable GP evaluator: owns its buffers, so [`GpPredictor::predict`] never allocates.
+#[derive(Clone, Debug)]
+pub struct GpPredictor {
+    kernel: SeArd,
+    input_scaling: Scaling,
+    output_scaling: Scaling,
+    /// Training inputs divided by the length scales, n x D row-major.
+    scaled_train: Vec<f64>,
+    /// `K^-1 V`, n x R row-major.
+    alpha: Vec<f64>,
+    /// `K^-1`, n x n row-major.
+    k_inv: Vec<f64>,
+    u: Vec<f64>,
+    k: Vec<f64>,
+    t: Vec<f64>,
+    out: Vec<f64>,
+}
+
+impl GpPredictor {
+    /// Builds an evaluator. `train_inputs` is n x D normalised, `alpha` n x R, `k_inv` n x n,
+    /// all row-major.
+    pub fn new(
+        kernel: SeArd,
+        input_scaling: Scaling,
+        output_scaling: Scaling,
+        train_inputs: &[f64],
+        alpha: Vec<f64>,
+        k_inv: Vec<f64>,
+    ) -> Self {
+        let d = kernel.length_scales.len();
+        let n = train_inputs.len() / d.max(1);
+        let r = output_scaling.len();
+        let scaled_train = kernel.compute_scaled_points(train_inputs);
+        GpPredictor {
+            kernel,
+            input_scaling,
+            output_scaling,
+            scaled_train,
+            alpha,
+            k_inv,
+            u: vec![0.0; d],
+            k: vec![0.0; n],
+            t: vec![0.0; n],
+            out: vec![0.0; r],
+        }
+    }
+
+    /// Number of outputs R.
+    pub fn n_outputs(&self) -> usize {
+        self.out.len()
+    }
+
+    /// Number of inputs D.
+    pub fn n_inputs(&self) -> usize {
+        self.u.len()
+    }
+
+    /// Predictive mean [Pa] at physical inputs `inputs` (length D: x [m], y [m], force [N]).
+    pub fn predict_inputs(&mut self, inputs: &[f64]) -> &[f64] {
+        let d = self.u.len();
+        self.u.copy_from_slice(&inputs[..d]);
+        self.input_scaling.forward_in_place(&mut self.u);
+        for (u, l) in self.u.iter_mut().zip(&self.kernel.length_scales) {
+            *u /= l;
+        }
+        for (ki, xi) in self.k.iter_mut().zip(self.scaled_train.chunks_exact(d)) {
+            *ki = self.kernel.compute_scaled(&self.u, xi);
+        }
+        self.out.iter_mut().for_each(|o| *o = 0.0);
+        accumulate_rows(&self.k, &self.alpha, &mut self.out);
+        self.output_scaling.inverse_in_place(&mut self.out);
+        &self.out
+    }
+
+    /// Predictive mean [Pa] and latent variance [Pa^2] (shared by all outputs) at `inputs`.
+    pub fn predict_with_variance(&mut self, inputs: &[f64]) -> (&[f64], f64) {
+        self.predict_inputs(inputs);
+        // t = K^-1 k* as a sum of rows (K^-1 is symmetric): contiguous, vectorisable updates
+        self.t.iter_mut().for_each(|t| *t = 0.0);
+        accumulate_rows(&self.k, &self.k_inv, &mut self.t);
+        let quad: f64 = self.k.iter().zip(&self.t).map(|(a, b)| a * b).sum();
+        let s_y = self.output_scaling.std.first().copied().unwrap_or(1.0);
+        let var = (self.kernel.signal_variance - quad).max(0.0) * s_y * s_y;
+        (&self.out, var)
+    }
+}

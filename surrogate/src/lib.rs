@@ -1,0 +1,47 @@
+//! Real-time stress surrogates for palpation: datasets in, trained models and predictions out.
+//!
+//! The reference study (a 2022 abdomen-palpation article, summarised in
+//! `shared/reference/paper-facts.md`) trained a multilayer perceptron mapping the finger's
+//! position and contact force to the maximum principal stress of 377 liver elements, and scored
+//! it with the Fit of its eq. 5 (92.64 % on three unseen locations). This crate provides:
+//!
+//! - [`dataset`]: the `.npz` + JSON dataset the campaign writes ([`Dataset`]).
+//! - [`mlp`]: the paper's MLP (3-64-126-256-512-R, ReLU), trained by `traingdx`-style gradient
+//!   descent or Adam with a hand-written single-threaded trainer, served by a hand-written
+//!   forward pass.
+//! - [`gp`]: a Gaussian process with one SE-ARD kernel shared by all outputs, hyperparameters
+//!   by marginal likelihood, predictive variance.
+//! - [`fit`]: paper eq. 5, per location and overall.
+//! - [`model`]: safetensors + JSON model files and the serving [`Predictor`].
+//! - [`api`]: [`train`], [`predict`], [`evaluate`] for the command line; [`render_map`] for PNG maps.
+//!
+//! It depends on no other palpa crate.
+
+#![warn(missing_docs)]
+
+pub mod api;
+pub mod dataset;
+pub mod error;
+pub mod fit;
+pub mod gp;
+pub mod kernels;
+pub mod lbfgs;
+pub mod mlp;
+pub mod model;
+pub mod normalise;
+pub mod render;
+pub mod report;
+pub mod rng;
+pub mod synthetic;
+pub mod tensor_file;
+
+pub use api::{
+    default_evaluation_configs, evaluate, predict, train, train_model, ModelConfig, Prediction,
+    TrainOptions,
+};
+pub use dataset::{Dataset, Manifest};
+pub use error::{Error, Result};
+pub use fit::{compute_fit, compute_fit_by_location};
+pub use model::{ModelKind, ModelMeta, Predictor, TrainedModel};
+pub use render::render_map;
+pub use report::{CostRow, EvaluationReport, LocationFit, TrainReport};

@@ -1,0 +1,430 @@
+//! Trained models on disk and the serving-time [`Predictor`].
+//!
+//! A model is two files: `NAME.safetensors` with the arrays and `NAME.json` with the metadata
+//! ([`ModelMeta`]: kind, architecture, scalings, kernel, training settings and report). Given a
+//! directory instead, they are `DIR/model.safetensors` and `DIR/model.json`.
+//!
+//! Tensors (row-major):
+//! - MLP: `layers.L.weight` `[n_out, n_in]` f32 (the PyTorch `nn.Linear` layout) and
+//!   `layers.L.bias` `[n_out]` f32, for L = 0 .. layers-1; normalised units (see `normalise`).
+//! - GP: `train_inputs` `[n, D]`, `alpha` `[n, R]` (= K^-1 V), `k_inv` `[n, n]`, all f64,
+//!   normalised units.
+//! - Both: `roi_centroids` `[R, 3]` f64 [m], for rendering maps from the model alone.
+
+use crate::dataset::write_atomic;
+use crate::error::{Error, Result};
+use crate::gp::{GpModel, GpPredictor, SeArd};
+use crate::mlp::{DenseLayer, MlpModel, MlpPredictor};
+use crate::normalise::Scaling;
+use crate::report::TrainReport;
+use crate::tensor_file::{
+    read_tensors, take_f32, take_f64, write_tensors, Tensor, TensorData, TensorSet,
+};
+use ndarray::{Array2, ArrayView2};
+use serde::{Deserialize, Serialize};
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+/// Value of [`ModelMeta::format`].
+pub const MODEL_FORMAT: &str = "palpa-surrogate";
+/// Current value of [`ModelMeta::version`].
+pub const MODEL_VERSION: u32 = 1;
+
+/// The surrogate families.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum ModelKind {
+    /// Multilayer perceptron.
+    Mlp,
+    /// Gaussian process.
+    Gp,
+}
+
+impl std::fmt::Display for ModelKind {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(match self {
+            ModelKind::Mlp => "mlp",
+            ModelKind::Gp => "gp",
+        })
+    }
+}
+
+impl std::str::FromStr for ModelKind {
+    type Err = Error;
+    fn from_str(s: &str) -> Result<Self> {
+        match s.to_ascii_lowercase().as_str() {
+            "mlp" => Ok(ModelKind::Mlp),
+            "gp" => Ok(ModelKind::Gp),
+            other => Err(Error::invalid(
+                "model kind",
+                format!("{other:?}, expected mlp or gp"),
+            )),
+        }
+    }
+}
+
+/// Metadata sidecar of a saved model.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ModelMeta {
+    /// Always `"palpa-surrogate"`.
+    pub format: String,
+    /// Format version, currently 1.
+    pub version: u32,
+    /// Model family.
+    pub kind: ModelKind,
+    /// Names of the inputs, in order (`x`, `y`, `force`); units m, m, N.
+    pub input_columns: Vec<String>,
+    /// ROI element ids of the outputs, in order; outputs are maximum principal stress [Pa].
+    pub roi_ids: Vec<i64>,
+    /// Input scaling (physical -> normalised).
+    pub input_scaling: Scaling,
+    /// Output scaling (normalised -> physical).
+    pub output_scaling: Scaling,
+    /// MLP layer widths `n_0 .. n_L` (empty for a GP).
+    #[serde(default)]
+    pub layer_sizes: Vec<usize>,
+    /// MLP hidden activation, `"relu"` (output layer linear).
+    #[serde(default)]
+    pub activation: String,
+    /// GP kernel hyperparameters (normalised units).
+    #[serde(default)]
+    pub kernel: Option<SeArd>,
+    /// Training settings and results.
+    pub report: TrainReport,
+}
+
+/// A model in memory, as training produces it.
+#[derive(Clone, Debug)]
+pub enum TrainedModel {
+    /// An MLP.
+    Mlp(MlpModel),
+    /// A GP.
+    Gp(GpModel),
+}
+
+/// The `.safetensors` and `.json` paths for `path` (see the module doc).
+pub fn model_paths(path: &Path) -> (PathBuf, PathBuf) {
+    match path.extension().and_then(|e| e.to_str()) {
+        Some("safetensors") => (path.to_path_buf(), path.with_extension("json")),
+        Some("json") => (path.with_extension("safetensors"), path.to_path_buf()),
+        _ => (path.join("model.safetensors"), path.join("model.json")),
+    }
+}
+
+impl TrainedModel {
+    /// The model family.
+    pub fn kind(&self) -> ModelKind {
+        match self {
+            TrainedModel::Mlp(_) => ModelKind::Mlp,
+            TrainedModel::Gp(_) => ModelKind::Gp,
+        }
+    }
+
+    /// Number of outputs R.
+    pub fn n_outputs(&self) -> usize {
+        match self {
+            TrainedModel::Mlp(m) => m.output_scaling.len(),
+            TrainedModel::Gp(g) => g.output_scaling.len(),
+        }
+    }
+
+    /// A serving predictor over this model (same arithmetic as after save and load).
+    pub fn to_predictor(&self) -> PredictorImpl {
+        match self {
+            TrainedModel::Mlp(m) => {
+                let p = &m.params;
+                let layers = (0..p.n_layers())
+                    .map(|l| DenseLayer {
+                        n_in: p.sizes[l],
+                        n_out: p.sizes[l + 1],
+                        weight: p.weights[l].clone(),
+                        bias: p.biases[l].clone(),
+                    })
+                    .collect();
+                PredictorImpl::Mlp(MlpPredictor::new(
+                    layers,
+                    m.input_scaling.clone(),
+                    m.output_scaling.clone(),
+                ))
+            }
+            TrainedModel::Gp(g) => PredictorImpl::Gp(GpPredictor::new(
+                g.kernel.clone(),
+                g.input_scaling.clone(),
+                g.output_scaling.clone(),
+                &g.train_inputs.iter().copied().collect::<Vec<_>>(),
+                g.alpha.iter().copied().collect(),
+                g.k_inv.iter().copied().collect(),
+            )),
+        }
+    }
+
+    /// Saves the model with its ROI (ids, centroids R x 3 [m]) and training report.
+    pub fn save(
+        &self,
+        path: impl AsRef<Path>,
+        roi_ids: &[i64],
+        roi_centroids: ArrayView2<f64>,
+        report: &TrainReport,
+    ) -> Result<()> {
+        let (st, js) = model_paths(path.as_ref());
+        if let Some(dir) = st.parent().filter(|d| !d.as_os_str().is_empty()) {
+            std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, e))?;
+        }
+        let r = self.n_outputs();
+        if roi_ids.len() != r || roi_centroids.dim() != (r, 3) {
+            return Err(Error::invalid(
+                "roi",
+                format!(
+                    "{} ids and centroids {:?} for a model of {r} outputs",
+                    roi_ids.len(),
+                    roi_centroids.dim()
+                ),
+            ));
+        }
+        let mut set = TensorSet::new();
+        set.insert(
+            "roi_centroids".into(),
+            Tensor {
+                shape: vec![r, 3],
+                data: TensorData::F64(roi_centroids.iter().copied().collect()),
+            },
+        );
+        let (input_scaling, output_scaling, layer_sizes, activation, kernel) = match self {
+            TrainedModel::Mlp(m) => {
+                let p = &m.params;
+                for l in 0..p.n_layers() {
+                    let (ni, no) = (p.sizes[l], p.sizes[l + 1]);
+                    // stored [n_out, n_in]: transpose of the input-major trainer layout
+                    let mut w = vec![0.0f32; ni * no];
+                    for i in 0..ni {
+                        for o in 0..no {
+                            w[o * ni + i] = p.weights[l][i * no + o];
+                        }
+                    }
+                    set.insert(
+                        format!("layers.{l}.weight"),
+                        Tensor {
+                            shape: vec![no, ni],
+                            data: TensorData::F32(w),
+                        },
+                    );
+                    set.insert(
+                        format!("layers.{l}.bias"),
+                        Tensor {
+                            shape: vec![no],
+                            data: TensorData::F32(p.biases[l].clone()),
+                        },
+                    );
+                }
+                (
+                    m.input_scaling.clone(),
+                    m.output_scaling.clone(),
+                    p.sizes.clone(),
+                    "relu".to_string(),
+                    None,
+                )
+            }
+            TrainedModel::Gp(g) => {
+                let put = |set: &mut TensorSet, name: &str, a: &Array2<f64>| {
+                    set.insert(
+                        name.into(),
+                        Tensor {
+                            shape: vec![a.nrows(), a.ncols()],
+                            data: TensorData::F64(a.iter().copied().collect()),
+                        },
+                    );
+                };
+                put(&mut set, "train_inputs", &g.train_inputs);
+                put(&mut set, "alpha", &g.alpha);
+                put(&mut set, "k_inv", &g.k_inv);
+                (
+                    g.input_scaling.clone(),
+                    g.output_scaling.clone(),
+                    Vec::new(),
+                    String::new(),
+                    Some(g.kernel.clone()),
+                )
+            }
+        };
+        let meta = ModelMeta {
+            format: MODEL_FORMAT.into(),
+            version: MODEL_VERSION,
+            kind: self.kind(),
+            input_columns: vec!["x".into(), "y".into(), "force".into()],
+            roi_ids: roi_ids.to_vec(),
+            input_scaling,
+            output_scaling,
+            layer_sizes,
+            activation,
+            kernel,
+            report: report.clone(),
+        };
+        write_tensors(&st, &set)?;
+        let text =
+            serde_json::to_string_pretty(&meta).map_err(|e| Error::format(&js, e.to_string()))?;
+        write_atomic(&js, |mut f| {
+            f.write_all(text.as_bytes()).map_err(|e| Error::io(&js, e))
+        })
+    }
+}
+
+/// The evaluator behind a [`Predictor`].
+#[derive(Clone, Debug)]
+pub enum PredictorImpl {
+    /// Hand-written MLP forward pass.
+    Mlp(MlpPredictor),
+    /// GP mean and variance.
+    Gp(GpPredictor),
+}
+
+impl PredictorImpl {
+    /// Prediction [Pa] at physical inputs (x [m], y [m], force [N]).
+    pub fn predict_inputs(&mut self, inputs: &[f64]) -> &[f64] {
+        match self {
+            PredictorImpl::Mlp(m) => m.predict_inputs(inputs),
+            PredictorImpl::Gp(g) => g.predict_inputs(inputs),
+        }
+    }
+}
+
+/// A loaded model ready to serve: reusable buffers, no allocation per prediction.
+#[derive(Clone, Debug)]
+pub struct Predictor {
+    meta: ModelMeta,
+    roi_centroids: Array2<f64>,
+    inner: PredictorImpl,
+}
+
+impl Predictor {
+    /// Loads `path` (`NAME.safetensors`, `NAME.json`, or a directory holding `model.*`).
+    pub fn load(path: impl AsRef<Path>) -> Result<Predictor> {
+        let (st, js) = model_paths(path.as_ref());
+        let text = std::fs::read_to_string(&js).map_err(|e| Error::io(&js, e))?;
+        let meta: ModelMeta =
+            serde_json::from_str(&text).map_err(|e| Error::format(&js, e.to_string()))?;
+        if meta.format != MODEL_FORMAT || meta.version > MODEL_VERSION {
+            return Err(Error::format(
+                &js,
+                format!(
+                    "format {:?} version {}, expected {MODEL_FORMAT:?} version <= {MODEL_VERSION}",
+                    meta.format, meta.version
+                ),
+            ));
+        }
+        let r = meta.roi_ids.len();
+        let d = meta.input_columns.len();
+        if meta.input_scaling.len() != d || meta.output_scaling.len() != r {
+            return Err(Error::format(
+                &js,
+                format!(
+                    "input_scaling has {} columns for {d} inputs, output_scaling {} for {r} ROI ids",
+                    meta.input_scaling.len(),
+                    meta.output_scaling.len()
+                ),
+            ));
+        }
+        let mut set = read_tensors(&st)?;
+        let c = take_f64(&mut set, &st, "roi_centroids", &[r, 3])?;
+        let roi_centroids =
+            Array2::from_shape_vec((r, 3), c).map_err(|e| Error::format(&st, e.to_string()))?;
+        let inner = match meta.kind {
+            ModelKind::Mlp => {
+                let s = &meta.layer_sizes;
+                if s.len() < 2 || s[0] != d || s[s.len() - 1] != r {
+                    return Err(Error::format(
+                        &js,
+                        format!("layer_sizes {s:?} do not match {d} inputs and {r} outputs"),
+                    ));
+                }
+                let mut layers = Vec::new();
+                for l in 0..s.len() - 1 {
+                    let (ni, no) = (s[l], s[l + 1]);
+                    let w = take_f32(&mut set, &st, &format!("layers.{l}.weight"), &[no, ni])?;
+                    let bias = take_f32(&mut set, &st, &format!("layers.{l}.bias"), &[no])?;
+                    let mut weight = vec![0.0f32; ni * no];
+                    for o in 0..no {
+                        for i in 0..ni {
+                            weight[i * no + o] = w[o * ni + i];
+                        }
+                    }
+                    layers.push(DenseLayer {
+                        n_in: ni,
+                        n_out: no,
+                        weight,
+                        bias,
+                    });
+                }
+                PredictorImpl::Mlp(MlpPredictor::new(
+                    layers,
+                    meta.input_scaling.clone(),
+                    meta.output_scaling.clone(),
+                ))
+            }
+            ModelKind::Gp => {
+                let kernel = meta
+                    .kernel
+                    .clone()
+                    .ok_or_else(|| Error::format(&js, "GP model without a kernel field"))?;
+                if kernel.length_scales.len() != d {
+                    return Err(Error::format(
+                        &js,
+                        "kernel.length_scales: one per input expected",
+                    ));
+                }
+                let n = set
+                    .get("train_inputs")
+                    .map(|t| t.shape.first().copied().unwrap_or(0))
+                    .ok_or_else(|| Error::format(&st, "missing tensor train_inputs"))?;
+                let u = take_f64(&mut set, &st, "train_inputs", &[n, d])?;
+                let alpha = take_f64(&mut set, &st, "alpha", &[n, r])?;
+                let k_inv = take_f64(&mut set, &st, "k_inv", &[n, n])?;
+                PredictorImpl::Gp(GpPredictor::new(
+                    kernel,
+                    meta.input_scaling.clone(),
+                    meta.output_scaling.clone(),
+                    &u,
+                    alpha,
+                    k_inv,
+                ))
+            }
+        };
+        Ok(Predictor {
+            meta,
+            roi_centroids,
+            inner,
+        })
+    }
+
+    /// ROI maximum principal stress [Pa] for a finger at (`x`, `y`) [m] pressing with `force` [N].
+    /// Allocation-free; the slice is valid until the next call.
+    pub fn predict(&mut self, x: f64, y: f64, force: f64) -> &[f64] {
+        self.inner.predict_inputs(&[x, y, force])
+    }
+
+    /// Like [`Predictor::predict`], plus the GP's predictive (latent) variance [Pa^2], shared
+    /// by all ROI elements; `None` for an MLP. Costs a little more than the mean alone.
+    pub fn predict_with_variance(&mut self, x: f64, y: f64, force: f64) -> (&[f64], Option<f64>) {
+        match &mut self.inner {
+            PredictorImpl::Gp(g) => {
+                let (m, v) = g.predict_with_variance(&[x, y, force]);
+                (m, Some(v))
+            }
+            PredictorImpl::Mlp(m) => (m.predict_inputs(&[x, y, force]), None),
+        }
+    }
+
+    /// The model's metadata (kind, architecture, training report, ...).
+    pub fn meta(&self) -> &ModelMeta {
+        &self.meta
+    }
+
+    /// ROI element centroids, R x 3 [m].
+    pub fn roi_centroids(&self) -> ArrayView2<'_, f64> {
+        self.roi_centroids.view()
+    }
+
+    /// Number of ROI outputs R.
+    pub fn n_outputs(&self) -> usize {
+        self.meta.roi_ids.len()
+    }
+}

@@ -1,0 +1,147 @@
+//! What training and evaluation report: Fit per location and overall, training time, latency,
+//! and the accuracy-versus-cost table.
+
+use crate::model::ModelKind;
+use serde::{Deserialize, Serialize};
+use std::fmt;
+
+/// Fit (paper eq. 5) on one location's samples.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct LocationFit {
+    /// Location index.
+    pub location: i64,
+    /// Location label from the dataset manifest.
+    pub label: String,
+    /// Samples scored.
+    pub n_samples: usize,
+    /// Fit on them (1 perfect, 0 no better than their mean).
+    pub fit: f64,
+}
+
+/// Outcome of training one model.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct TrainReport {
+    /// Model family.
+    pub kind: ModelKind,
+    /// Architecture in words, e.g. `3-64-126-256-512-377` or `SE-ARD, n=150`.
+    pub size: String,
+    /// Number of stored parameters (weights and biases; for a GP, the entries of alpha).
+    pub n_params: usize,
+    /// Training samples.
+    pub n_train: usize,
+    /// Test (held-out) samples scored.
+    pub n_test: usize,
+    /// Wall time of the fit [s].
+    pub train_seconds: f64,
+    /// Epochs run (MLP).
+    pub epochs: Option<usize>,
+    /// Final training loss (MLP, normalised mean squared error) or log marginal likelihood per
+    /// target (GP).
+    pub final_objective: f64,
+    /// Fit on the training samples.
+    pub train_fit: f64,
+    /// Fit on all test samples pooled (`None` without test samples).
+    pub test_fit: Option<f64>,
+    /// Fit per test location.
+    pub test_fit_by_location: Vec<LocationFit>,
+    /// Mean single-prediction latency of the serving predictor [us], one thread.
+    pub latency_us: f64,
+    /// Training settings, as JSON.
+    pub settings: serde_json::Value,
+}
+
+impl fmt::Display for TrainReport {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        writeln!(
+            f,
+            "model {} ({}, {} parameters), {} training samples, trained in {:.2} s{}",
+            self.kind,
+            self.size,
+            self.n_params,
+            self.n_train,
+            self.train_seconds,
+            self.epochs
+                .map(|e| format!(" ({e} epochs)"))
+                .unwrap_or_default()
+        )?;
+        writeln!(f, "Fit on training samples: {:.4}", self.train_fit)?;
+        for l in &self.test_fit_by_location {
+            writeln!(
+                f,
+                "Fit on test location {} ({} samples): {:.4}",
+                l.label, l.n_samples, l.fit
+            )?;
+        }
+        match self.test_fit {
+            Some(v) => writeln!(f, "Fit on all {} test samples: {:.4}", self.n_test, v)?,
+            None => writeln!(f, "no test samples (split == 1) in the dataset")?,
+        }
+        write!(f, "prediction latency: {:.1} us", self.latency_us)
+    }
+}
+
+/// One row of the accuracy-versus-cost table: a model configuration under leave-one-location-out
+/// cross-validation.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct CostRow {
+    /// Configuration name.
+    pub name: String,
+    /// Model family.
+    pub kind: ModelKind,
+    /// Architecture in words.
+    pub size: String,
+    /// Stored parameters.
+    pub n_params: usize,
+    /// Fit over all held-out predictions pooled.
+    pub fit_pooled: f64,
+    /// Mean of the per-location Fits.
+    pub fit_mean: f64,
+    /// Worst per-location Fit.
+    pub fit_min: f64,
+    /// Mean training time per fold [s].
+    pub train_seconds: f64,
+    /// Mean prediction latency [us].
+    pub latency_us: f64,
+    /// Fit per held-out location.
+    pub by_location: Vec<LocationFit>,
+}
+
+/// Result of `evaluate`: one row per configuration.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct EvaluationReport {
+    /// Number of folds (locations) per configuration.
+    pub n_folds: usize,
+    /// The table.
+    pub rows: Vec<CostRow>,
+}
+
+impl fmt::Display for EvaluationReport {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        writeln!(
+            f,
+            "leave-one-location-out cross-validation, {} folds",
+            self.n_folds
+        )?;
+        writeln!(
+            f,
+            "| model | kind | size | params | Fit pooled | Fit mean | Fit min | train s/fold | latency us |"
+        )?;
+        writeln!(f, "|---|---|---|---:|---:|---:|---:|---:|---:|")?;
+        for r in &self.rows {
+            writeln!(
+                f,
+                "| {} | {} | {} | {} | {:.4} | {:.4} | {:.4} | {:.2} | {:.1} |",
+                r.name,
+                r.kind,
+                r.size,
+                r.n_params,
+                r.fit_pooled,
+                r.fit_mean,
+                r.fit_min,
+                r.train_seconds,
+                r.latency_us
+            )?;
+        }
+        Ok(())
+    }
+}
