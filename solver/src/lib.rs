@@ -3,6 +3,7 @@
 #![warn(missing_docs)]
 
 pub mod bc;
+pub mod campaign;
 pub mod contact_stage;
 pub mod curve;
 pub mod element;

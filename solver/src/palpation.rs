@@ -198,6 +198,29 @@ impl PalpationSetup {
         Ok(())
     }
 
+    /// The phantom parameters its scene asks for (to build the phantom once and share it, see
+    /// [`crate::scene::build::build_scene_with`]).
+    pub fn phantom_params(&self) -> Result<crate::phantom::PhantomParams, String> {
+        use material::quantity::{Length, Number};
+        crate::scene::phantom_spec::PhantomScene {
+            variant: Some(self.variant.clone()),
+            voxel: Some(Length(self.voxel)),
+            fat_thickness: Some(Length(self.fat_thickness)),
+            respiratory_phase: Some(Number(self.respiratory_phase)),
+            tumours: self
+                .tumours
+                .iter()
+                .map(|t| crate::scene::phantom_spec::TumourScene {
+                    center: t.center.map(Length),
+                    radius: Length(t.radius),
+                    stiffness: Number(t.stiffness),
+                })
+                .collect(),
+            ..Default::default()
+        }
+        .to_params()
+    }
+
     /// The scene file text. Every quantity is written in SI with its unit.
     pub fn scene_toml(&self) -> String {
         let mut s = String::new();

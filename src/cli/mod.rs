@@ -1,8 +1,17 @@
 //! Command-line parsing and dispatch.
 
 mod check;
+mod evaluate;
+mod material;
+mod mesh;
+mod palpate;
+mod predict;
 mod progress;
 mod run;
+mod study;
+mod train;
+mod units;
+mod verify;
 
 use clap::{Parser, Subcommand};
 use std::path::PathBuf;
@@ -17,6 +26,9 @@ pub struct Cli {
 
 #[derive(Subcommand)]
 enum Command {
+    /// The main job: press the two-finger hand 15 mm into the built-in abdomen phantom with the
+    /// paper's materials, and write VTK frames, history, ROI stresses and plots into --out.
+    Palpate(palpate::PalpateArgs),
     /// Run a scene and write VTK frames, history.csv and summary.json into --out.
     Run {
         /// The scene file (TOML).
@@ -36,6 +48,56 @@ enum Command {
         /// The scene file (TOML).
         scene: PathBuf,
     },
+    /// Material-point driver: drive one law through the path of FILE.toml (uniaxial stress or
+    /// strain, simple shear, equibiaxial; ramps, holds, cycles) and write the CSV table
+    /// (time, stretch, nominal and Cauchy stress, wave speed, dissipation, history).
+    Material {
+        /// The driver file (TOML), e.g. scenes/materials/liver-uniaxial.toml.
+        file: PathBuf,
+        /// Write the CSV here (atomically) instead of to stdout.
+        #[arg(long, value_name = "FILE.csv")]
+        out: Option<PathBuf>,
+    },
+    /// Build meshes: the procedural abdomen phantom, or a user's labelled segmentation.
+    Mesh {
+        #[command(subcommand)]
+        what: mesh::MeshCommand,
+    },
+    /// Run the verification suite (reference solvers and closed forms), print the table, write
+    /// a Markdown report and plots into --out; non-zero exit if any case fails.
+    Verify {
+        /// Run the hard-case suite instead.
+        #[arg(long)]
+        hard: bool,
+        /// Output directory for the report and plots.
+        #[arg(long, default_value = "verification-report")]
+        out: PathBuf,
+    },
+    /// Accuracy against cost: vary mesh size, element formulation, mass scaling and time-step
+    /// factor on the phantom palpation; write study.csv, study.md and Pareto plots into --out.
+    Study {
+        /// The quick profile (coarse phantom, 6 mm in 6 ms): a few minutes on 2 cores.
+        #[arg(long)]
+        quick: bool,
+        /// Output directory.
+        #[arg(long, default_value = "results/study")]
+        out: PathBuf,
+        /// Worker threads (default: all cores).
+        #[arg(long)]
+        threads: Option<usize>,
+        /// No progress bar.
+        #[arg(long)]
+        quiet: bool,
+    },
+    /// Train a stress surrogate (MLP or GP) on a dataset, print its Fit (paper eq. 5) on the
+    /// held-out test locations and the training time, save it as safetensors + JSON.
+    Train(train::TrainArgs),
+    /// Predict the ROI stress [Pa] with a saved surrogate for a finger at x, y [m] pressing with
+    /// a force [N], optionally rendering the map; or stream JSON lines with --stdin.
+    Predict(predict::PredictArgs),
+    /// Leave-one-location-out cross-validation of each surrogate type and size, and the
+    /// accuracy-versus-cost table (Fit, training time, prediction latency).
+    Evaluate(evaluate::EvaluateArgs),
 }
 
 /// Set the global thread pool.
@@ -55,6 +117,10 @@ pub fn set_threads(threads: Option<usize>) -> Result<(), String> {
 /// Run the chosen command.
 pub fn dispatch(cli: Cli) -> Result<(), String> {
     match cli.command {
+        Command::Palpate(a) => {
+            set_threads(a.threads)?;
+            palpate::palpate(&a)
+        }
         Command::Run {
             scene,
             out,
@@ -65,5 +131,20 @@ pub fn dispatch(cli: Cli) -> Result<(), String> {
             run::run(&scene, &out, quiet)
         }
         Command::Check { scene } => check::check(&scene),
+        Command::Study {
+            quick,
+            out,
+            threads,
+            quiet,
+        } => {
+            set_threads(threads)?;
+            study::study(quick, &out, quiet)
+        }
+        Command::Material { file, out } => material::material(&file, out.as_deref()),
+        Command::Mesh { what } => mesh::mesh(what),
+        Command::Verify { hard, out } => verify::verify(hard, &out),
+        Command::Train(a) => train::train(&a),
+        Command::Predict(a) => predict::predict(&a),
+        Command::Evaluate(a) => evaluate::run(&a),
     }
 }

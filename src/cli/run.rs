@@ -2,7 +2,7 @@
 
 use super::progress::{stop_flag, time_bar};
 use solver::run::{run_scene, RunSummary};
-use solver::scene::load_scene;
+use solver::scene::{load_scene, Scene};
 use std::path::Path;
 use std::time::Instant;
 
@@ -60,22 +60,37 @@ pub fn run(scene_path: &Path, out: &Path, quiet: bool) -> Result<(), String> {
             scene.sim.model.mesh.nodes.len(),
             t0.elapsed().as_secs_f64()
         );
-        if scene.sim.model.added_mass() > 0.0 {
-            for m in &scene.sim.model.part_mass {
-                println!(
-                    "  mass scaling: part {} +{:.3} % ({} of {} elements scaled)",
-                    m.name,
-                    100.0 * m.added / m.physical,
-                    m.scaled_elements,
-                    m.elements
-                );
-            }
+    }
+    let (summary, err) = run_loaded(&mut scene, out, quiet);
+    print_summary(&summary);
+    println!("  output: {}", out.display());
+    match err {
+        Some(e) => Err(e),
+        None => Ok(()),
+    }
+}
+
+/// Run a built scene into `out` with a progress bar and Ctrl-C handling; print the added mass
+/// first. Returns the summary and the error, if the run failed.
+pub fn run_loaded(scene: &mut Scene, out: &Path, quiet: bool) -> (RunSummary, Option<String>) {
+    for n in &scene.notes {
+        println!("  note: {n}");
+    }
+    if !quiet && scene.sim.model.added_mass() > 0.0 {
+        for m in &scene.sim.model.part_mass {
+            println!(
+                "  mass scaling: part {} +{:.3} % ({} of {} elements scaled)",
+                m.name,
+                100.0 * m.added / m.physical,
+                m.scaled_elements,
+                m.elements
+            );
         }
     }
     let stop = stop_flag();
     let pb = time_bar(scene.end_time, quiet);
     let wall = Instant::now();
-    let (summary, err) = run_scene(&mut scene, out, &stop, |p| {
+    let res = run_scene(scene, out, &stop, |p| {
         pb.set_position((p.sim.time * 1e6) as u64);
         let rate = p.sim.step as f64 / wall.elapsed().as_secs_f64().max(1e-9);
         pb.set_message(format!(
@@ -85,10 +100,5 @@ pub fn run(scene_path: &Path, out: &Path, quiet: bool) -> Result<(), String> {
         ));
     });
     pb.finish_and_clear();
-    print_summary(&summary);
-    println!("  output: {}", out.display());
-    match err {
-        Some(e) => Err(e),
-        None => Ok(()),
-    }
+    res
 }

@@ -12,6 +12,7 @@
 //! - [`cases::cantilever`]: tip deflection vs scikit-fem Q1 and Timoshenko beam theory.
 //! - [`cases::closed`]: Ogden, Prony, plasticity, wave speed, free vibration, Hertz.
 //! - [`hard`]: the hard-case suite (`palpa verify --hard`).
+//! - [`study`]: accuracy against cost (`palpa study`).
 //!
 //! [`run_suite`] runs the default suite; [`report`] prints the table and writes the Markdown
 //! report and the convergence plots.
@@ -23,6 +24,7 @@ pub mod hard;
 pub mod plot;
 pub mod quasi;
 pub mod report;
+pub mod study;
 
 pub use report::{Row, Status};
 

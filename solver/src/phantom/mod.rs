@@ -29,7 +29,8 @@
 //!   are roller faces (fix the normal displacement). Cut faces stay exactly planar through
 //!   smoothing.
 //! - "skin": nodes of the anterior skin, the faces of the outer surface (not on a cut
-//!   plane) whose outward normal has z > 0.3; the faces themselves are in
+//!   plane) whose outward normal has z > 0.05 (every upward-facing face, so that a steep,
+//!   smoothed voxel step on a coarse mesh leaves no hole under a palpation location); the faces themselves are in
 //!   [`Phantom::skin_faces`] (outward normal by the right-hand rule), for finger contact.
 //!
 //! # Counts
@@ -225,7 +226,7 @@ pub fn build(p: &PhantomParams) -> Result<Phantom, String> {
         .boundary_faces()
         .into_iter()
         .filter(|f| !f.nodes.iter().all(|&n| on_plane(mesh.nodes[n as usize])))
-        .filter(|f| face_normal(&mesh, &f.nodes)[2] > 0.3)
+        .filter(|f| face_normal(&mesh, &f.nodes)[2] > 0.05)
         .map(|f| f.nodes)
         .collect();
     let mut skin: Vec<u32> = skin_faces.iter().flatten().copied().collect();

@@ -80,11 +80,16 @@ fn err(
 
 /// Read, parse and build a scene file.
 pub fn load_scene(path: &Path) -> Result<Scene, String> {
+    load_scene_with(path, None)
+}
+
+/// [`load_scene`], reusing an already built phantom (see [`build_scene_with`]).
+pub fn load_scene_with(path: &Path, prebuilt: Option<Phantom>) -> Result<Scene, String> {
     let src = std::fs::read_to_string(path)
         .map_err(|e| format!("{}: cannot read the scene file: {e}", path.display()))?;
     let spec: SceneSpec = toml::from_str(&src)
         .map_err(|e| format!("{}: {}", path.display(), e.to_string().trim_end()))?;
-    build_scene(spec, path, &src)
+    build_scene_with(spec, path, &src, prebuilt)
 }
 
 fn axis(s: &str) -> Option<usize> {

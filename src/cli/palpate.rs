@@ -1,0 +1,249 @@
+//! `palpa palpate`: the main job. Builds the reduced abdomen phantom, presses the two-finger
+//! hand into it with the paper's materials and protocol ([`solver::palpation`]), and writes
+//! into `--out`:
+//! - `scene.toml`: the scene that was run (`palpa run` repeats it);
+//! - `frame_*.vtu` + `frame.pvd` (ParaView), `history.csv`, `summary.json`;
+//! - `probe.csv` / `probe_stress.csv`: the ROI's stresses every 5 ms;
+//! - `roi_stress.csv`: per ROI element its centroid and maximum principal stress at each sample;
+//! - `roi.csv`, `locations.json`: the ROI and the palpation locations of the phantom;
+//! - `force_indentation.png` and `roi_stress_map.png`.
+
+use super::run::{print_summary, run_loaded};
+use super::units;
+use solver::output::atomic::write_atomic;
+use solver::output::history::{column, read_history};
+use solver::palpation::{read_probe, ElementChoice, PalpationSetup, Place, ProbeSamples};
+use solver::scene::load_scene;
+use std::fmt::Write;
+use std::path::Path;
+use std::time::Instant;
+
+/// Command-line options of `palpa palpate`.
+#[derive(clap::Args, Debug)]
+pub struct PalpateArgs {
+    /// Press at a point (x, y) of the body surface, e.g. `-50mm,190mm` (plain numbers: m).
+    #[arg(long, allow_hyphen_values = true, conflicts_with = "location")]
+    pub at: Option<String>,
+    /// Press at a named phantom location: A (liver near the surface), B (deeper), C (under
+    /// the ribs), or P01..P25 (the 5 x 5 raster). Default A.
+    #[arg(long)]
+    pub location: Option<String>,
+    /// Indentation depth.
+    #[arg(long, default_value = "15mm")]
+    pub depth: String,
+    /// Time to reach the depth (smooth ramp); the run ends then.
+    #[arg(long, default_value = "25ms")]
+    pub duration: String,
+    /// Interval between ROI stress samples and VTK frames.
+    #[arg(long, default_value = "5ms")]
+    pub sample_interval: String,
+    /// Voxel edge of the phantom: 5mm (default, ~23k hexahedra, about two minutes on 2 cores)
+    /// or 3mm (close to the paper's CT, ~105k hexahedra).
+    #[arg(long)]
+    pub voxel: Option<String>,
+    /// The paper's resolution: the same as `--voxel 3mm`.
+    #[arg(long, conflicts_with = "voxel")]
+    pub paper: bool,
+    /// Phantom variant: reduced (the paper's reduced model) or full.
+    #[arg(long, default_value = "reduced")]
+    pub variant: String,
+    /// Subcutaneous fat thickness.
+    #[arg(long, default_value = "15mm")]
+    pub fat: String,
+    /// Respiratory phase, 0 (exhalation) .. 1 (inspiration).
+    #[arg(long, default_value_t = 0.0)]
+    pub phase: f64,
+    /// Element formulation: one_point (viscous hourglass), stiffness (one-point, stiffness
+    /// hourglass) or full_fbar.
+    #[arg(long, default_value = "one_point")]
+    pub element: String,
+    /// Selective mass scaling to this time step, e.g. `4us` (off by default).
+    #[arg(long)]
+    pub mass_scaling: Option<String>,
+    /// Time-step safety factor.
+    #[arg(long, default_value_t = solver::simulation::DEFAULT_DT_FACTOR)]
+    pub dt_factor: f64,
+    /// Skip the VTK frames.
+    #[arg(long)]
+    pub no_vtk: bool,
+    /// Output directory.
+    #[arg(long, default_value = "results/palpate")]
+    pub out: std::path::PathBuf,
+    /// Worker threads (default: all cores).
+    #[arg(long)]
+    pub threads: Option<usize>,
+    /// No progress bar.
+    #[arg(long)]
+    pub quiet: bool,
+}
+
+impl PalpateArgs {
+    /// The palpation these options describe.
+    pub fn setup(&self) -> Result<PalpationSetup, String> {
+        let mut s = PalpationSetup::default();
+        s.place = match (&self.at, &self.location) {
+            (Some(xy), _) => {
+                let v = units::lengths(xy, 2, "--at")?;
+                Place::At(v[0], v[1])
+            }
+            (None, Some(n)) => Place::Named(n.to_uppercase()),
+            (None, None) => Place::Named("A".into()),
+        };
+        s.depth = units::length(&self.depth, "--depth")?;
+        s.duration = units::time(&self.duration, "--duration")?;
+        s.sample_interval = units::time(&self.sample_interval, "--sample-interval")?;
+        if self.paper {
+            s.voxel = solver::phantom::PAPER_VOXEL;
+        }
+        if let Some(v) = &self.voxel {
+            s.voxel = units::length(v, "--voxel")?;
+        }
+        if !["reduced", "full"].contains(&self.variant.as_str()) {
+            return Err(format!("--variant: `{}` is not reduced or full", self.variant));
+        }
+        s.variant = self.variant.clone();
+        s.fat_thickness = units::length(&self.fat, "--fat")?;
+        s.respiratory_phase = self.phase;
+        s.element = self.element.parse::<ElementChoice>().map_err(|e| format!("--element: {e}"))?;
+        s.mass_scaling_dt = self
+            .mass_scaling
+            .as_deref()
+            .map(|t| units::time(t, "--mass-scaling"))
+            .transpose()?;
+        s.dt_factor = self.dt_factor;
+        s.vtk = !self.no_vtk;
+        s.title = match &s.place {
+            Place::Named(n) => format!("palpation at {n}"),
+            Place::At(x, y) => format!("palpation at ({:.1} mm, {:.1} mm)", x * 1e3, y * 1e3),
+        };
+        s.validate()?;
+        Ok(s)
+    }
+}
+
+/// Run `palpa palpate`.
+pub fn palpate(args: &PalpateArgs) -> Result<(), String> {
+    let setup = args.setup()?;
+    let out = &args.out;
+    std::fs::create_dir_all(out)
+        .map_err(|e| format!("{}: cannot create the output directory: {e}", out.display()))?;
+    let scene_path = out.join("scene.toml");
+    write_atomic(&scene_path, setup.scene_toml().as_bytes())?;
+    let t0 = Instant::now();
+    let mut scene = load_scene(&scene_path)?;
+    let build_s = t0.elapsed().as_secs_f64();
+    let ph = scene
+        .phantom
+        .as_ref()
+        .ok_or("internal: the palpation scene has no phantom")?;
+    write_atomic(&out.join("roi.csv"), ph.roi.to_csv().as_bytes())?;
+    write_atomic(&out.join("locations.json"), ph.locations.to_json().as_bytes())?;
+    let centroids = ph.roi.centroids.clone();
+    if !args.quiet {
+        println!(
+            "{}: {} voxel {:.1} mm: {} hexahedra, {} nodes, ROI {} elements; built in {:.2} s",
+            setup.title,
+            setup.variant,
+            setup.voxel * 1e3,
+            scene.sim.model.mesh.elements.len(),
+            scene.sim.model.mesh.nodes.len(),
+            centroids.len(),
+            build_s
+        );
+    }
+    let (summary, err) = run_loaded(&mut scene, out, args.quiet);
+    print_summary(&summary);
+    // Post-processing also for a failed run: what was written stays usable.
+    let post = postprocess(out, &centroids);
+    match (&post, &err) {
+        (Ok(p), _) => {
+            println!(
+                "  peak force {:.2} N at {:.2} mm indentation; ROI max principal stress {:.3} .. {:.3} kPa (peak |.| {:.3} kPa)",
+                p.peak_force,
+                p.depth_at_peak * 1e3,
+                p.stress_min / 1e3,
+                p.stress_max / 1e3,
+                p.stress_min.abs().max(p.stress_max.abs()) / 1e3
+            );
+        }
+        (Err(e), None) => return Err(e.clone()),
+        (Err(_), Some(_)) => {}
+    }
+    println!("  output: {}", out.display());
+    match err {
+        Some(e) => Err(e),
+        None => Ok(()),
+    }
+}
+
+/// Figures of a finished palpation.
+struct Post {
+    peak_force: f64,
+    depth_at_peak: f64,
+    stress_min: f64,
+    stress_max: f64,
+}
+
+/// Write `roi_stress.csv` and the two plots; return the headline figures.
+fn postprocess(out: &Path, centroids: &[[f64; 3]]) -> Result<Post, String> {
+    let (cols, rows) = read_history(&out.join("history.csv"))?;
+    let travel = column(&cols, &rows, "hand_travel").ok_or("history.csv has no hand_travel")?;
+    let force = column(&cols, &rows, "hand_reaction").ok_or("history.csv has no hand_reaction")?;
+    let (k, &peak) = force
+        .iter()
+        .enumerate()
+        .max_by(|a, b| a.1.total_cmp(b.1))
+        .ok_or("history.csv is empty")?;
+    let probe = read_probe(out, "hand")?;
+    write_atomic(&out.join("roi_stress.csv"), roi_csv(&probe, centroids).as_bytes())?;
+    let series = verification::Series {
+        plot: "force_indentation".into(),
+        title: "two-finger palpation: force against indentation".into(),
+        axes: ("indentation (mm)".into(), "force (N)".into()),
+        log: false,
+        curves: vec![(
+            "palpa".into(),
+            travel.iter().zip(&force).map(|(d, f)| (d * 1e3, *f)).collect(),
+        )],
+    };
+    verification::plot::draw(&series, out)?;
+    let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+    for row in &probe.stress {
+        for &s in row {
+            lo = lo.min(s);
+            hi = hi.max(s);
+        }
+    }
+    if let Some(last) = probe.stress.last() {
+        if !last.is_empty() && last.len() == centroids.len() {
+            let c = ndarray::Array2::from_shape_fn((centroids.len(), 3), |(i, j)| centroids[i][j]);
+            surrogate::render_map(c.view(), last, &out.join("roi_stress_map.png"))
+                .map_err(|e| format!("roi_stress_map.png: {e}"))?;
+        }
+    }
+    Ok(Post {
+        peak_force: peak,
+        depth_at_peak: travel[k],
+        stress_min: lo,
+        stress_max: hi,
+    })
+}
+
+/// `element,x,y,z,s_<t ms>...`: per ROI element its centroid (m) and its maximum principal
+/// stress (Pa) at each sample time.
+fn roi_csv(p: &ProbeSamples, centroids: &[[f64; 3]]) -> String {
+    let mut s = String::from("element,x,y,z");
+    for t in &p.time {
+        let _ = write!(s, ",s_{:.3}ms", t * 1e3);
+    }
+    s.push('\n');
+    for (i, e) in p.elements.iter().enumerate() {
+        let c = centroids.get(i).copied().unwrap_or([f64::NAN; 3]);
+        let _ = write!(s, "{e},{:.6},{:.6},{:.6}", c[0], c[1], c[2]);
+        for row in &p.stress {
+            let _ = write!(s, ",{:.6e}", row[i]);
+        }
+        s.push('\n');
+    }
+    s
+}

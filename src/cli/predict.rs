@@ -1,0 +1,209 @@
+//! `palpa predict MODEL --x X --y Y --force F [--png map.png]` and `palpa predict MODEL --stdin`:
+//! serve a saved surrogate.
+//!
+//! Inputs are SI: the finger position x, y in metres (the dataset's frame) and the contact force
+//! in newtons; outputs are the maximum principal stress of each ROI element in pascals.
+//!
+//! - One-shot: prints the ROI stress vector (one `element_id stress_Pa` line per ROI element,
+//!   after a header), the GP's predictive standard deviation when the model is a GP, and with
+//!   `--png` renders the 2-D map of the ROI stress ([`surrogate::render_map`]).
+//! - `--stdin`, for a live device loop: reads one JSON object per line,
+//!   `{"x": 0.04, "y": 0.05, "force": 20.0}` (an optional `"id"` of any JSON type is echoed back),
+//!   and writes one JSON line per input line, flushed at once:
+//!   `{"line": 1, "stress": [...], "variance": null}` (`variance` [Pa^2] for a GP). A line that
+//!   cannot be used gets `{"line": N, "error": "..."}` and the stream goes on; blank lines are
+//!   skipped. A closed stdout (the reader has gone) ends the stream quietly. The model is
+//!   loaded once ([`surrogate::Predictor`], the hand-written forward pass).
+
+use serde_json::{json, Map, Value};
+use std::fmt::Write as _;
+use std::io::{BufRead, Write};
+use std::path::{Path, PathBuf};
+use surrogate::model::model_paths;
+use surrogate::Predictor;
+
+/// `palpa predict`'s arguments. Units are SI: x and y in metres, force in newtons, stress out
+/// in pascals.
+#[derive(clap::Args)]
+pub struct PredictArgs {
+    /// The model `palpa train --out` saved: a directory (model.safetensors + model.json) or
+    /// NAME.safetensors / NAME.json.
+    pub model: PathBuf,
+    /// Finger position x [m], in the dataset's frame (a plain number, e.g. 0.04).
+    #[arg(long, allow_negative_numbers = true, required_unless_present = "stdin")]
+    pub x: Option<f64>,
+    /// Finger position y [m], in the dataset's frame (a plain number, e.g. 0.05).
+    #[arg(long, allow_negative_numbers = true, required_unless_present = "stdin")]
+    pub y: Option<f64>,
+    /// Contact force [N] (a plain number, e.g. 20).
+    #[arg(long, allow_negative_numbers = true, required_unless_present = "stdin")]
+    pub force: Option<f64>,
+    /// Also render the 2-D map of the ROI stress (x-y projection of the ROI centroids) to this
+    /// PNG file.
+    #[arg(long)]
+    pub png: Option<PathBuf>,
+    /// Stream instead: read JSON lines {"x": m, "y": m, "force": N, "id": optional} from stdin,
+    /// write one JSON line per input, {"line": n, "id": .., "stress": [Pa, ...], "variance":
+    /// Pa^2 or null}, flushed at once; a bad line gets {"line": n, "error": ".."} and the stream
+    /// goes on.
+    #[arg(long, conflicts_with_all = ["x", "y", "force", "png"])]
+    pub stdin: bool,
+}
+
+/// Run `palpa predict`.
+pub fn predict(a: &PredictArgs) -> Result<(), String> {
+    match (a.stdin, a.x, a.y, a.force) {
+        (true, ..) => predict_stdin(&a.model),
+        (false, Some(x), Some(y), Some(force)) => {
+            predict_one(&a.model, x, y, force, a.png.as_deref())
+        }
+        _ => Err("give --x, --y and --force, or --stdin".into()),
+    }
+}
+
+/// A model path that does not exist gets a message naming it and saying what is expected;
+/// otherwise the model is loaded.
+pub fn load_model(path: &Path) -> Result<Predictor, String> {
+    let (st, js) = model_paths(path);
+    if !path.exists() && !st.exists() && !js.exists() {
+        return Err(format!(
+            "model {}: no such file or directory (expected a directory holding \
+             model.safetensors and model.json, or NAME.safetensors beside NAME.json, as \
+             `palpa train --out` writes)",
+            path.display()
+        ));
+    }
+    Predictor::load(path).map_err(|e| format!("model {}: {e}", path.display()))
+}
+
+/// One input value, which must be a finite number.
+fn check_finite(name: &str, v: f64) -> Result<f64, String> {
+    if v.is_finite() {
+        Ok(v)
+    } else {
+        Err(format!("{name} = {v} is not a finite number"))
+    }
+}
+
+/// One-shot prediction: print the vector, optionally render the map.
+pub fn predict_one(
+    model: &Path,
+    x: f64,
+    y: f64,
+    force: f64,
+    png: Option<&Path>,
+) -> Result<(), String> {
+    let x = check_finite("--x", x)?;
+    let y = check_finite("--y", y)?;
+    let force = check_finite("--force", force)?;
+    let mut p = load_model(model)?;
+    let meta = p.meta().clone();
+    let (stress, variance) = p.predict_with_variance(x, y, force);
+    let stress = stress.to_vec();
+    let mut text = format!(
+        "{} model {} ({}): {} ROI elements\nfinger at x = {x} m, y = {y} m, force = {force} N\n",
+        meta.kind,
+        model.display(),
+        meta.report.size,
+        stress.len()
+    );
+    if let Some(v) = variance {
+        let _ = writeln!(
+            text,
+            "GP predictive standard deviation (all ROI elements): {:.6e} Pa",
+            v.max(0.0).sqrt()
+        );
+    }
+    if let Some(path) = png {
+        surrogate::render_map(p.roi_centroids(), &stress, path)
+            .map_err(|e| format!("--png {}: {e}", path.display()))?;
+        let _ = writeln!(text, "map: {}", path.display());
+    }
+    text.push_str("ROI maximum principal stress [Pa]:\nelement_id stress_Pa\n");
+    for (id, s) in meta.roi_ids.iter().zip(&stress) {
+        let _ = writeln!(text, "{id} {s:.6e}");
+    }
+    let mut out = std::io::stdout().lock();
+    write_or_closed(out.write_all(text.as_bytes()).and_then(|_| out.flush())).map(|_| ())
+}
+
+/// A write to stdout: `Ok(true)` when done, `Ok(false)` when the reader has gone (a closed
+/// pipe, as with `| head`: stop quietly), an error message otherwise.
+fn write_or_closed(r: std::io::Result<()>) -> Result<bool, String> {
+    match r {
+        Ok(()) => Ok(true),
+        Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => Ok(false),
+        Err(e) => Err(format!("writing to stdout: {e}")),
+    }
+}
+
+/// The (x, y, force) of one JSON input line, and its optional `id`.
+fn parse_line(text: &str) -> Result<([f64; 3], Option<Value>), String> {
+    let v: Value = serde_json::from_str(text).map_err(|e| format!("not JSON: {e}"))?;
+    let Value::Object(mut obj) = v else {
+        return Err(r#"expected an object {"x": .., "y": .., "force": ..}"#.into());
+    };
+    let id = obj.remove("id");
+    let mut take = |name: &str, unit: &str| -> Result<f64, String> {
+        match obj.remove(name) {
+            None => Err(format!("missing field \"{name}\" (a number, {unit})")),
+            Some(Value::Number(n)) => {
+                let v = n
+                    .as_f64()
+                    .ok_or_else(|| format!("field \"{name}\": {n} is not a number"))?;
+                check_finite(name, v)
+            }
+            Some(other) => Err(format!(
+                "field \"{name}\": expected a plain number ({unit}), got {other}"
+            )),
+        }
+    };
+    let input = [take("x", "m")?, take("y", "m")?, take("force", "N")?];
+    if let Some(k) = obj.keys().next() {
+        return Err(format!(
+            "unknown field \"{k}\" (expected x, y, force and optionally id)"
+        ));
+    }
+    Ok((input, id))
+}
+
+/// Streaming prediction: JSON lines in, JSON lines out (see the module doc).
+pub fn predict_stdin(model: &Path) -> Result<(), String> {
+    let mut p = load_model(model)?;
+    let stdin = std::io::stdin();
+    let stdout = std::io::stdout();
+    let mut out = stdout.lock();
+    let (mut served, mut failed) = (0usize, 0usize);
+    for (k, line) in stdin.lock().lines().enumerate() {
+        let n = k + 1;
+        let line = line.map_err(|e| format!("reading stdin line {n}: {e}"))?;
+        if line.trim().is_empty() {
+            continue;
+        }
+        let reply = match parse_line(&line) {
+            Ok(([x, y, force], id)) => {
+                served += 1;
+                let (stress, variance) = p.predict_with_variance(x, y, force);
+                let mut m = Map::new();
+                m.insert("line".into(), json!(n));
+                if let Some(id) = id {
+                    m.insert("id".into(), id);
+                }
+                m.insert("stress".into(), json!(stress));
+                m.insert("variance".into(), json!(variance));
+                Value::Object(m)
+            }
+            Err(e) => {
+                failed += 1;
+                json!({ "line": n, "error": format!("line {n}: {e}") })
+            }
+        };
+        let mut bytes = serde_json::to_vec(&reply).map_err(|e| e.to_string())?;
+        bytes.push(b'\n');
+        if !write_or_closed(out.write_all(&bytes).and_then(|_| out.flush()))? {
+            break;
+        }
+    }
+    eprintln!("palpa predict: {served} prediction(s), {failed} line(s) with errors");
+    Ok(())
+}

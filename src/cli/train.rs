@@ -1,0 +1,164 @@
+//! `palpa train DATASET --model mlp|gp --out MODEL`: train a stress surrogate on a palpation
+//! dataset, print its Fit (paper eq. 5) on the held-out test locations (split 1), per location
+//! and overall, with the training time and the serving latency, and save the model as
+//! safetensors + JSON metadata.
+//!
+//! Training, scoring and saving are [`surrogate::train`]'s; this module only maps the command
+//! line onto [`surrogate::TrainOptions`] and checks the paths first, so that a wrong path gets a
+//! message naming it.
+
+use surrogate::mlp::{AdamOptions, GdxOptions, Optimiser};
+use surrogate::model::model_paths;
+use surrogate::{ModelKind, TrainOptions};
+
+use std::path::{Path, PathBuf};
+
+/// The model family, as `--model` spells it.
+#[derive(Clone, Copy, Debug, clap::ValueEnum)]
+pub enum ModelArg {
+    /// The paper's multilayer perceptron (3-64-126-256-512-R, ReLU).
+    Mlp,
+    /// Gaussian process with one SE-ARD kernel shared by all ROI outputs.
+    Gp,
+}
+
+impl From<ModelArg> for ModelKind {
+    fn from(m: ModelArg) -> ModelKind {
+        match m {
+            ModelArg::Mlp => ModelKind::Mlp,
+            ModelArg::Gp => ModelKind::Gp,
+        }
+    }
+}
+
+/// The MLP optimiser, as `--optimizer` spells it.
+#[derive(Clone, Copy, Debug, clap::ValueEnum)]
+pub enum OptimizerArg {
+    /// Gradient descent with momentum and adaptive learning rate (MATLAB's traingdx, the paper's).
+    Gdx,
+    /// Adam with a geometrically decaying learning rate.
+    Adam,
+}
+
+/// `palpa train`'s arguments.
+#[derive(clap::Args)]
+pub struct TrainArgs {
+    /// The dataset: a directory holding dataset.npz + manifest.json, or NAME.npz beside
+    /// NAME.json. Split-0 samples train, split-1 samples (held-out locations) are scored.
+    pub dataset: PathBuf,
+    /// Model family.
+    #[arg(long, value_enum)]
+    pub model: ModelArg,
+    /// Where to save the model: a directory (model.safetensors + model.json) or
+    /// NAME.safetensors (beside NAME.json).
+    #[arg(long)]
+    pub out: PathBuf,
+    /// MLP optimiser.
+    #[arg(long, value_enum, default_value = "adam")]
+    pub optimizer: OptimizerArg,
+    /// MLP epochs [default: 3000; training stops early past 110 s].
+    #[arg(long)]
+    pub epochs: Option<usize>,
+    /// Seed of the MLP's initial weights and batch order, and of the GP's restarts
+    /// [default: 42 (MLP), 7 (GP)].
+    #[arg(long)]
+    pub seed: Option<u64>,
+    /// MLP hidden layer widths, comma-separated [default: the paper's 64,126,256,512].
+    #[arg(long, value_delimiter = ',')]
+    pub hidden: Option<Vec<usize>>,
+    /// GP: random restarts of the marginal-likelihood search besides the default start
+    /// [default: 3].
+    #[arg(long)]
+    pub restarts: Option<usize>,
+    /// Worker threads of the global pool [default: all cores]. The trainers themselves run on
+    /// one thread, so that a seed gives the same model on any machine.
+    #[arg(long)]
+    pub threads: Option<usize>,
+}
+
+/// A dataset path that does not exist gets a message naming it and saying what is expected.
+pub fn check_dataset_path(path: &Path) -> Result<(), String> {
+    let (npz, json) = surrogate::dataset::dataset_paths(path);
+    if !path.exists() {
+        return Err(format!(
+            "dataset {}: no such file or directory (expected a directory holding dataset.npz and \
+             manifest.json, or NAME.npz beside NAME.json)",
+            path.display()
+        ));
+    }
+    for f in [&npz, &json] {
+        if !f.is_file() {
+            return Err(format!(
+                "dataset {}: {} is missing",
+                path.display(),
+                f.display()
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// The training options the flags ask for, on top of the crate's defaults.
+fn options(a: &TrainArgs) -> Result<TrainOptions, String> {
+    let mut opts = TrainOptions::default();
+    let mlp = &mut opts.mlp;
+    mlp.optimiser = match a.optimizer {
+        OptimizerArg::Gdx => Optimiser::Gdx(GdxOptions::default()),
+        OptimizerArg::Adam => Optimiser::Adam(AdamOptions::default()),
+    };
+    if let Some(e) = a.epochs {
+        if e == 0 {
+            return Err("--epochs must be at least 1".into());
+        }
+        mlp.epochs = e;
+    }
+    if let Some(h) = &a.hidden {
+        if h.is_empty() || h.contains(&0) {
+            return Err(format!(
+                "--hidden {h:?}: give one or more positive layer widths, e.g. 64,126,256,512"
+            ));
+        }
+        mlp.hidden = h.clone();
+    }
+    if let Some(s) = a.seed {
+        mlp.seed = s;
+        opts.gp.seed = s;
+    }
+    if let Some(r) = a.restarts {
+        opts.gp.restarts = r;
+    }
+    Ok(opts)
+}
+
+/// Train, report and save.
+pub fn train(a: &TrainArgs) -> Result<(), String> {
+    super::set_threads(a.threads)?;
+    check_dataset_path(&a.dataset)?;
+    let opts = options(a)?;
+    let kind = ModelKind::from(a.model);
+    let what = match kind {
+        ModelKind::Mlp => {
+            let opt = match a.optimizer {
+                OptimizerArg::Gdx => "traingdx",
+                OptimizerArg::Adam => "Adam",
+            };
+            format!(
+                "MLP, hidden {:?}, {opt}, {} epochs at most ({:.0} s cap), seed {}",
+                opts.mlp.hidden, opts.mlp.epochs, opts.mlp.max_seconds, opts.mlp.seed
+            )
+        }
+        ModelKind::Gp => format!(
+            "GP, SE-ARD kernel by marginal likelihood, {} restart(s), seed {}",
+            opts.gp.restarts, opts.gp.seed
+        ),
+    };
+    eprintln!("palpa train: {what} on {} ...", a.dataset.display());
+    let report = surrogate::train(&a.dataset, kind, &opts, &a.out)
+        .map_err(|e| format!("train {}: {e}", a.dataset.display()))?;
+    println!("Fit = 1 - sqrt(SSE / SST), paper eq. 5 (1 perfect, 0 no better than the mean)");
+    println!("{report}");
+    println!("training time: {:.2} s", report.train_seconds);
+    let (st, js) = model_paths(&a.out);
+    println!("saved {} and {}", st.display(), js.display());
+    Ok(())
+}
