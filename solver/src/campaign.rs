@@ -1,0 +1,865 @@
+//! Palpation campaigns: many palpations of one phantom, the raw material of a surrogate's
+//! training dataset (`palpa campaign`).
+//!
+//! A campaign is a [`CampaignSpec`] (a TOML file, or the paper's protocol when none is given)
+//! resolved into a [`Campaign`]: a list of locations, each labelled train or test, and a list of
+//! [`PlannedRun`]s, the product of locations x depths x durations in a fixed order. Every run is
+//! an ordinary palpation ([`PalpationSetup`]) written as `scene.toml` into its own directory
+//! `DIR/runs/<label>/` and run there; a run is finished when its `done.json` ([`DoneMarker`])
+//! exists, written atomically after everything else. A directory without it is an interrupted or
+//! failed run and is redone from scratch.
+//!
+//! # The file
+//! Every key is optional; the defaults are the paper's protocol (`shared/reference/paper-facts.md`):
+//! the 25 raster points P01..P25 for training, A, B, C for testing, 15 mm in 25 ms, a sample every
+//! 5 ms, on the default reduced phantom (5 mm voxels). Quantities take units as in scene files,
+//! and unknown keys are errors.
+//!
+//! ```toml
+//! title = "paper protocol"
+//!
+//! [phantom]                        # as a scene's [mesh.phantom] (these keys only)
+//! variant = "reduced"              # or "full"
+//! voxel = "5 mm"
+//! fat_thickness = "15 mm"
+//! respiratory_phase = 0.0
+//! tumours = [{ center = ["-60 mm", "180 mm", "150 mm"], radius = "10 mm", stiffness = 5.0 }]
+//!
+//! [locations]
+//! train = ["grid"]                 # "grid" = P01..P25; names A, B, C, P01..P25;
+//!                                  # points ["-50 mm", "190 mm"]; { name = "D", at = [x, y] }
+//! test = ["A", "B", "C"]
+//! [[locations.raster]]             # optional further rasters of points (x, y of the skin)
+//! center = ["-50 mm", "195 mm"]
+//! spacing = ["10 mm", "10 mm"]
+//! n = [3, 3]
+//! split = "train"                  # or "test"
+//! prefix = "R"                     # names R01, R02, ... (cranial row first, then by x)
+//!
+//! [indentation]
+//! depth = "15 mm"                  # one value or a list: every depth is run
+//! duration = "25 ms"               # one value or a list; or speed = "0.6 m/s" (depth / duration)
+//! sample_interval = "5 ms"         # samples at 0, 5, ..., 25 ms
+//!
+//! [hand]
+//! diameter = "15 mm"
+//! spacing = "20 mm"
+//!
+//! [solver]
+//! element = "one_point"            # one_point | stiffness | full_fbar
+//! dt_factor = 0.75
+//! # mass_scaling = "4 us"          # selective mass scaling target step (off by default)
+//! # mass_scaling_limit = 0.05
+//! vtk = false                      # VTK frames of every run (off: only the probe files)
+//! ```
+//!
+//! # Order, labels and shards
+//! Locations come in the order train entries, train rasters, test entries, test rasters; runs
+//! loop over locations, then depths, then durations. A run's label is its location's label, or
+//! `<location>_d<depth>mm_t<duration>ms` when the campaign has more than one depth or duration.
+//! Run `k` (0-based, in this order) belongs to shard `k mod n` ([`in_shard`]).
+
+use crate::output::atomic::write_atomic;
+use crate::output::history::{column, read_history};
+use crate::palpation::{read_probe, ElementChoice, PalpationSetup, Place, TumourSetup};
+use crate::phantom::{location_at, Location, Phantom, PhantomParams};
+use crate::scene::build::build_scene_with;
+use crate::scene::phantom_spec::TumourScene;
+use crate::scene::{Scene, SceneSpec};
+use material::quantity::{Length, Number, Time, Velocity};
+use serde::{Deserialize, Deserializer, Serialize};
+use serde_json::json;
+use std::path::{Path, PathBuf};
+
+/// Name of the marker file of a finished run.
+pub const DONE_FILE: &str = "done.json";
+/// Name of the campaign description in a campaign directory.
+pub const CAMPAIGN_FILE: &str = "campaign.json";
+/// Value of the `format` key of [`CAMPAIGN_FILE`].
+pub const CAMPAIGN_FORMAT: &str = "palpa-campaign";
+
+/// One value or a list of values (`depth = "15 mm"` or `depth = ["10 mm", "15 mm"]`).
+#[derive(Clone, Debug, PartialEq)]
+pub struct OneOrMany<T>(pub Vec<T>);
+
+impl<'de, T: serde::de::DeserializeOwned> Deserialize<'de> for OneOrMany<T> {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        use serde::de::Error;
+        let v = toml::Value::deserialize(d)?;
+        let one = |x: toml::Value| T::deserialize(x).map_err(|e| D::Error::custom(e.message()));
+        match v {
+            toml::Value::Array(a) => Ok(OneOrMany(a.into_iter().map(one).collect::<Result<_, _>>()?)),
+            x => Ok(OneOrMany(vec![one(x)?])),
+        }
+    }
+}
+
+/// A campaign file (see the module doc).
+#[derive(Clone, Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CampaignSpec {
+    /// Title (default "palpation campaign").
+    pub title: Option<String>,
+    /// The phantom.
+    #[serde(default)]
+    pub phantom: PhantomSpec,
+    /// Where to press.
+    #[serde(default)]
+    pub locations: LocationsSpec,
+    /// How deep, how fast, how often to sample.
+    #[serde(default)]
+    pub indentation: IndentationSpec,
+    /// The two fingers.
+    #[serde(default)]
+    pub hand: HandSpec,
+    /// Element formulation and time step.
+    #[serde(default)]
+    pub solver: SolverSpec,
+}
+
+/// `[phantom]`.
+#[derive(Clone, Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PhantomSpec {
+    /// `reduced` (default) or `full`.
+    pub variant: Option<String>,
+    /// Voxel edge (default 5 mm).
+    pub voxel: Option<Length>,
+    /// Subcutaneous fat thickness (default 15 mm).
+    pub fat_thickness: Option<Length>,
+    /// Respiratory phase 0..1 (default 0).
+    pub respiratory_phase: Option<Number>,
+    /// Liver tumours.
+    #[serde(default)]
+    pub tumours: Vec<TumourScene>,
+}
+
+/// A location entry: a name, a point, or a named point.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(untagged)]
+pub enum LocationEntry {
+    /// `"A"`, `"P07"`, or `"grid"` for P01..P25.
+    Name(String),
+    /// `["-50 mm", "190 mm"]`: a point (x, y) of the body surface.
+    Point([Length; 2]),
+    /// `{ name = "D", at = ["-50 mm", "190 mm"] }`.
+    Named(NamedPoint),
+}
+
+/// A point with a name.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct NamedPoint {
+    /// Label.
+    pub name: String,
+    /// (x, y) of the body surface.
+    pub at: [Length; 2],
+}
+
+/// A raster of points.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct RasterSpec {
+    /// Centre (x, y).
+    pub center: [Length; 2],
+    /// Distance between neighbours along x and y.
+    pub spacing: [Length; 2],
+    /// Points along x and y.
+    pub n: [usize; 2],
+    /// `train` or `test`.
+    pub split: String,
+    /// Label prefix (default "R"): R01, R02, ...
+    pub prefix: Option<String>,
+}
+
+/// `[locations]`.
+#[derive(Clone, Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct LocationsSpec {
+    /// Training locations (default `["grid"]`).
+    pub train: Option<Vec<LocationEntry>>,
+    /// Test locations (default `["A", "B", "C"]`).
+    pub test: Option<Vec<LocationEntry>>,
+    /// Further rasters of points.
+    #[serde(default)]
+    pub raster: Vec<RasterSpec>,
+}
+
+/// `[indentation]`.
+#[derive(Clone, Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct IndentationSpec {
+    /// Depth(s) (default 15 mm).
+    pub depth: Option<OneOrMany<Length>>,
+    /// Time(s) to reach the depth (default 25 ms).
+    pub duration: Option<OneOrMany<Time>>,
+    /// Mean speed(s), instead of durations: duration = depth / speed.
+    pub speed: Option<OneOrMany<Velocity>>,
+    /// Interval between samples (default 5 ms).
+    pub sample_interval: Option<Time>,
+}
+
+/// `[hand]`.
+#[derive(Clone, Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct HandSpec {
+    /// Finger diameter (default 15 mm).
+    pub diameter: Option<Length>,
+    /// Centre-to-centre finger spacing (default 20 mm).
+    pub spacing: Option<Length>,
+}
+
+/// `[solver]`.
+#[derive(Clone, Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SolverSpec {
+    /// `one_point` (default), `stiffness` or `full_fbar`.
+    pub element: Option<String>,
+    /// Time-step safety factor (default 0.75).
+    pub dt_factor: Option<Number>,
+    /// Selective mass scaling to this step (off by default).
+    pub mass_scaling: Option<Time>,
+    /// Largest added mass fraction (default 0.05).
+    pub mass_scaling_limit: Option<Number>,
+    /// Write VTK frames of every run (default false).
+    pub vtk: Option<bool>,
+}
+
+/// Training or test location.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Split {
+    /// Used for training (dataset split 0).
+    Train,
+    /// Held out (dataset split 1).
+    Test,
+}
+
+impl Split {
+    /// 0 for train, 1 for test.
+    pub fn code(self) -> u8 {
+        match self {
+            Split::Train => 0,
+            Split::Test => 1,
+        }
+    }
+    /// "train" or "test".
+    pub fn name(self) -> &'static str {
+        match self {
+            Split::Train => "train",
+            Split::Test => "test",
+        }
+    }
+}
+
+/// One location of a campaign.
+#[derive(Clone, Debug, PartialEq)]
+pub struct CampaignLocation {
+    /// Label (a phantom location's name, or the point's name).
+    pub label: String,
+    /// Train or test.
+    pub split: Split,
+    /// Where the fingers press.
+    pub place: Place,
+}
+
+/// One run of a campaign.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PlannedRun {
+    /// Position in the campaign's order (0-based).
+    pub index: usize,
+    /// Directory name under `runs/`.
+    pub label: String,
+    /// Index into [`Campaign::locations`].
+    pub location: usize,
+    /// Indentation depth (m).
+    pub depth: f64,
+    /// Time to reach it (s).
+    pub duration: f64,
+}
+
+/// A resolved campaign: the common palpation settings, the locations and the runs.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Campaign {
+    /// Title.
+    pub title: String,
+    /// Settings shared by every run (its place, depth and duration are replaced per run).
+    pub base: PalpationSetup,
+    /// Locations in order.
+    pub locations: Vec<CampaignLocation>,
+    /// Runs in order.
+    pub runs: Vec<PlannedRun>,
+}
+
+/// `v` with at most `d` decimals, trailing zeros removed.
+fn short(v: f64, d: usize) -> String {
+    let s = format!("{v:.d$}");
+    if s.contains('.') {
+        s.trim_end_matches('0').trim_end_matches('.').to_string()
+    } else {
+        s
+    }
+}
+
+fn check_label(l: &str) -> Result<(), String> {
+    if l.is_empty()
+        || !l
+            .chars()
+            .all(|c| c.is_ascii_alphanumeric() || matches!(c, '-' | '_' | '.'))
+        || l.starts_with('.')
+    {
+        return Err(format!(
+            "location label `{l}`: use letters, digits, `-`, `_` and `.` (it names a directory)"
+        ));
+    }
+    Ok(())
+}
+
+fn entry_locations(e: &LocationEntry, split: Split) -> Result<Vec<CampaignLocation>, String> {
+    let named = |n: &str| CampaignLocation {
+        label: n.to_string(),
+        split,
+        place: Place::Named(n.to_string()),
+    };
+    Ok(match e {
+        LocationEntry::Name(n) if n.eq_ignore_ascii_case("grid") => {
+            let g = crate::phantom::GridParams::default();
+            (1..=g.n[0] * g.n[1]).map(|k| named(&format!("P{k:02}"))).collect()
+        }
+        LocationEntry::Name(n) => {
+            let n = n.to_ascii_uppercase();
+            let ok = matches!(n.as_str(), "A" | "B" | "C")
+                || (n.len() == 3
+                    && n.starts_with('P')
+                    && n[1..].parse::<usize>().is_ok_and(|k| (1..=25).contains(&k)));
+            if !ok {
+                return Err(format!(
+                    "unknown location `{n}`: A, B, C, P01..P25, \"grid\", a point [x, y] or {{ name, at }}"
+                ));
+            }
+            vec![named(&n)]
+        }
+        LocationEntry::Point(p) => {
+            let (x, y) = (p[0].0, p[1].0);
+            vec![CampaignLocation {
+                label: format!("at_{}_{}", short(x * 1e3, 1), short(y * 1e3, 1)),
+                split,
+                place: Place::At(x, y),
+            }]
+        }
+        LocationEntry::Named(p) => {
+            check_label(&p.name)?;
+            vec![CampaignLocation {
+                label: p.name.clone(),
+                split,
+                place: Place::At(p.at[0].0, p.at[1].0),
+            }]
+        }
+    })
+}
+
+fn raster_locations(r: &RasterSpec) -> Result<(Split, Vec<CampaignLocation>), String> {
+    let split = match r.split.as_str() {
+        "train" => Split::Train,
+        "test" => Split::Test,
+        o => return Err(format!("locations.raster: split `{o}` is not train or test")),
+    };
+    let prefix = r.prefix.clone().unwrap_or_else(|| "R".into());
+    check_label(&prefix)?;
+    let [nx, ny] = r.n;
+    if nx == 0 || ny == 0 {
+        return Err("locations.raster: n must be at least [1, 1]".into());
+    }
+    let (c, s) = ([r.center[0].0, r.center[1].0], [r.spacing[0].0, r.spacing[1].0]);
+    let mut out = Vec::new();
+    // cranial row first (largest y), each row from the patient's right (smallest x)
+    for j in (0..ny).rev() {
+        for i in 0..nx {
+            let x = c[0] + (i as f64 - (nx as f64 - 1.0) / 2.0) * s[0];
+            let y = c[1] + (j as f64 - (ny as f64 - 1.0) / 2.0) * s[1];
+            out.push(CampaignLocation {
+                label: format!("{prefix}{:02}", out.len() + 1),
+                split,
+                place: Place::At(x, y),
+            });
+        }
+    }
+    Ok((split, out))
+}
+
+impl CampaignSpec {
+    /// Read and parse a campaign file.
+    pub fn load(path: &Path) -> Result<CampaignSpec, String> {
+        let src = std::fs::read_to_string(path)
+            .map_err(|e| format!("{}: cannot read the campaign file: {e}", path.display()))?;
+        toml::from_str(&src).map_err(|e| format!("{}: {}", path.display(), e.to_string().trim_end()))
+    }
+
+    /// Resolve into a campaign (checks values; the phantom is not built here).
+    pub fn resolve(&self) -> Result<Campaign, String> {
+        let mut base = PalpationSetup {
+            vtk: false,
+            ..Default::default()
+        };
+        let p = &self.phantom;
+        if let Some(v) = &p.variant {
+            v.parse::<crate::phantom::Variant>()?;
+            base.variant = v.clone();
+        }
+        if let Some(v) = p.voxel {
+            base.voxel = v.0;
+        }
+        if let Some(v) = p.fat_thickness {
+            base.fat_thickness = v.0;
+        }
+        if let Some(v) = p.respiratory_phase {
+            base.respiratory_phase = v.0;
+        }
+        base.tumours = p
+            .tumours
+            .iter()
+            .map(|t| TumourSetup {
+                center: [t.center[0].0, t.center[1].0, t.center[2].0],
+                radius: t.radius.0,
+                stiffness: t.stiffness.0,
+            })
+            .collect();
+        if let Some(d) = self.hand.diameter {
+            base.finger_diameter = d.0;
+        }
+        if let Some(s) = self.hand.spacing {
+            base.finger_spacing = s.0;
+        }
+        let sv = &self.solver;
+        if let Some(e) = &sv.element {
+            base.element = e.parse::<ElementChoice>()?;
+        }
+        if let Some(f) = sv.dt_factor {
+            base.dt_factor = f.0;
+        }
+        base.mass_scaling_dt = sv.mass_scaling.map(|t| t.0);
+        if let Some(l) = sv.mass_scaling_limit {
+            base.mass_scaling_limit = l.0;
+        }
+        base.vtk = sv.vtk.unwrap_or(false);
+        let ind = &self.indentation;
+        if let Some(t) = ind.sample_interval {
+            base.sample_interval = t.0;
+        }
+        let depths: Vec<f64> = match &ind.depth {
+            Some(d) => d.0.iter().map(|x| x.0).collect(),
+            None => vec![base.depth],
+        };
+        if depths.is_empty() {
+            return Err("indentation.depth: the list is empty".into());
+        }
+        let mut timing: Vec<Box<dyn Fn(f64) -> f64>> = Vec::new();
+        match (&ind.duration, &ind.speed) {
+            (Some(_), Some(_)) => {
+                return Err("indentation: give `duration` or `speed`, not both".into());
+            }
+            (Some(d), None) => {
+                for t in &d.0 {
+                    let t = t.0;
+                    timing.push(Box::new(move |_| t));
+                }
+            }
+            (None, Some(s)) => {
+                for v in &s.0 {
+                    let v = v.0;
+                    if !(v > 0.0 && v.is_finite()) {
+                        return Err(format!("indentation.speed must be positive, got {v} m/s"));
+                    }
+                    timing.push(Box::new(move |depth| depth / v));
+                }
+            }
+            (None, None) => {
+                let t = base.duration;
+                timing.push(Box::new(move |_| t));
+            }
+        }
+        if timing.is_empty() {
+            return Err("indentation: the list of durations or speeds is empty".into());
+        }
+
+        let l = &self.locations;
+        let default_train = vec![LocationEntry::Name("grid".into())];
+        let default_test: Vec<LocationEntry> =
+            ["A", "B", "C"].iter().map(|n| LocationEntry::Name(n.to_string())).collect();
+        let mut locations = Vec::new();
+        let rasters: Vec<(Split, Vec<CampaignLocation>)> =
+            l.raster.iter().map(raster_locations).collect::<Result<_, _>>()?;
+        for (split, entries) in [
+            (Split::Train, l.train.as_ref().unwrap_or(&default_train)),
+            (Split::Test, l.test.as_ref().unwrap_or(&default_test)),
+        ] {
+            for e in entries {
+                locations.extend(entry_locations(e, split)?);
+            }
+            for (s, r) in &rasters {
+                if *s == split {
+                    locations.extend(r.iter().cloned());
+                }
+            }
+        }
+        if locations.is_empty() {
+            return Err("locations: the campaign has no locations".into());
+        }
+        for (i, a) in locations.iter().enumerate() {
+            if locations[..i].iter().any(|b| b.label == a.label) {
+                return Err(format!(
+                    "locations: `{}` appears twice (a location is either train or test, once)",
+                    a.label
+                ));
+            }
+        }
+
+        let several = depths.len() * timing.len() > 1;
+        let mut runs = Vec::new();
+        for (li, loc) in locations.iter().enumerate() {
+            for &depth in &depths {
+                for tf in &timing {
+                    let duration = tf(depth);
+                    let label = if several {
+                        format!(
+                            "{}_d{}mm_t{}ms",
+                            loc.label,
+                            short(depth * 1e3, 3),
+                            short(duration * 1e3, 3)
+                        )
+                    } else {
+                        loc.label.clone()
+                    };
+                    if runs.iter().any(|r: &PlannedRun| r.label == label) {
+                        return Err(format!("two runs would be labelled `{label}`: make the depths and durations distinct"));
+                    }
+                    runs.push(PlannedRun {
+                        index: runs.len(),
+                        label,
+                        location: li,
+                        depth,
+                        duration,
+                    });
+                }
+            }
+        }
+        let c = Campaign {
+            title: self.title.clone().unwrap_or_else(|| "palpation campaign".into()),
+            base,
+            locations,
+            runs,
+        };
+        for r in &c.runs {
+            c.setup(r).validate().map_err(|e| format!("run {}: {e}", r.label))?;
+        }
+        Ok(c)
+    }
+}
+
+impl Campaign {
+    /// The paper's protocol (the defaults of every key).
+    pub fn paper() -> Campaign {
+        CampaignSpec::default()
+            .resolve()
+            .expect("the default campaign is valid")
+    }
+
+    /// The palpation of run `r`.
+    pub fn setup(&self, r: &PlannedRun) -> PalpationSetup {
+        PalpationSetup {
+            title: format!("{}: {}", self.title, r.label),
+            place: self.locations[r.location].place.clone(),
+            depth: r.depth,
+            duration: r.duration,
+            ..self.base.clone()
+        }
+    }
+
+    /// Samples each run records: at 0, sample_interval, ... up to the duration.
+    pub fn samples_per_run(&self, r: &PlannedRun) -> usize {
+        (r.duration / self.base.sample_interval * (1.0 + 1e-9)).floor() as usize + 1
+    }
+
+    /// The phantom parameters every run's scene asks for (read back from the scene text, so
+    /// that a phantom built from them is reused by [`build_scene_with`]).
+    pub fn phantom_params(&self) -> Result<PhantomParams, String> {
+        let src = self.base.scene_toml();
+        let spec: SceneSpec = toml::from_str(&src).map_err(|e| format!("internal: campaign scene: {e}"))?;
+        spec.mesh.phantom.unwrap_or_default().to_params()
+    }
+
+    /// Resolve each location on the built phantom (its skin point); an error names a location
+    /// that does not exist or is not over the skin.
+    pub fn resolve_locations(&self, ph: &Phantom) -> Result<Vec<Location>, String> {
+        self.locations
+            .iter()
+            .map(|l| match &l.place {
+                Place::Named(n) => ph.locations.get(n).cloned().ok_or_else(|| {
+                    format!("location {n}: the phantom has no such location")
+                }),
+                Place::At(x, y) => location_at(&ph.mesh, &ph.skin_faces, &ph.volume, &l.label, *x, *y)
+                    .map_err(|e| format!("location {}: {e}", l.label)),
+            })
+            .collect()
+    }
+
+    /// Write run `r`'s `scene.toml` into `dir` and build it, reusing `phantom`.
+    pub fn build_run_scene(&self, r: &PlannedRun, dir: &Path, phantom: &Phantom) -> Result<Scene, String> {
+        std::fs::create_dir_all(dir)
+            .map_err(|e| format!("{}: cannot create the run directory: {e}", dir.display()))?;
+        let path = dir.join("scene.toml");
+        let src = self.setup(r).scene_toml();
+        write_atomic(&path, src.as_bytes())?;
+        let spec: SceneSpec =
+            toml::from_str(&src).map_err(|e| format!("{}: {}", path.display(), e.to_string().trim_end()))?;
+        build_scene_with(spec, &path, &src, Some(phantom.clone()))
+    }
+
+    /// The description of the campaign that must agree between its shards and resumed
+    /// invocations: settings, phantom, resolved locations, ROI and runs (JSON).
+    pub fn plan_json(&self, ph: &Phantom, locs: &[Location]) -> serde_json::Value {
+        let b = &self.base;
+        let p = &ph.params;
+        json!({
+            "title": self.title,
+            "settings": {
+                "sample_interval_s": b.sample_interval,
+                "finger_diameter_m": b.finger_diameter,
+                "finger_spacing_m": b.finger_spacing,
+                "element": b.element.label(),
+                "dt_factor": b.dt_factor,
+                "mass_scaling_dt_s": b.mass_scaling_dt,
+                "mass_scaling_limit": b.mass_scaling_limit,
+                "vtk": b.vtk,
+            },
+            "phantom": phantom_json(p),
+            "roi": {
+                "center_m": ph.roi.center,
+                "elements": ph.roi.elements,
+                "centroids_m": ph.roi.centroids,
+            },
+            "locations": self.locations.iter().zip(locs).map(|(l, s)| json!({
+                "label": l.label,
+                "split": l.split.name(),
+                "kind": match l.place { Place::Named(_) => "phantom", Place::At(..) => "point" },
+                "surface_m": s.surface,
+                "liver_depth_m": s.liver_depth,
+                "under_ribs": s.under_ribs,
+            })).collect::<Vec<_>>(),
+            "runs": self.runs.iter().map(|r| json!({
+                "index": r.index,
+                "label": r.label,
+                "location": self.locations[r.location].label,
+                "depth_m": r.depth,
+                "duration_s": r.duration,
+                "samples": self.samples_per_run(r),
+            })).collect::<Vec<_>>(),
+        })
+    }
+}
+
+/// The phantom parameters as JSON (SI).
+pub fn phantom_json(p: &PhantomParams) -> serde_json::Value {
+    json!({
+        "variant": format!("{:?}", p.variant).to_lowercase(),
+        "voxel_m": p.voxel,
+        "fat_thickness_m": p.fat_thickness,
+        "respiratory_phase": p.respiratory_phase,
+        "max_liver_shift_m": p.max_liver_shift,
+        "torso_m": [p.torso_width, p.torso_depth, p.torso_length],
+        "coarsen": p.mesh.coarsen,
+        "tumours": p.tumours.iter().map(|t| json!({
+            "center_m": t.center, "radius_m": t.radius, "stiffness_factor": t.stiffness_factor,
+        })).collect::<Vec<_>>(),
+        "roi_radius_m": p.roi.radius,
+        "roi_max_count": p.roi.max_count,
+        "grid": { "center_m": p.grid.center, "spacing_m": p.grid.spacing, "n": p.grid.n },
+    })
+}
+
+/// Parse `i/n` (0 <= i < n).
+pub fn parse_shard(s: &str) -> Result<(usize, usize), String> {
+    let bad = || format!("--shard: expected i/n with 0 <= i < n, e.g. 0/4, got `{s}`");
+    let (i, n) = s.split_once('/').ok_or_else(bad)?;
+    let (i, n): (usize, usize) = (i.trim().parse().map_err(|_| bad())?, n.trim().parse().map_err(|_| bad())?);
+    if n == 0 || i >= n {
+        return Err(bad());
+    }
+    Ok((i, n))
+}
+
+/// Whether run `index` belongs to shard `(i, n)`: `index mod n == i`.
+pub fn in_shard(index: usize, shard: (usize, usize)) -> bool {
+    index % shard.1 == shard.0
+}
+
+/// Directory of run `label` in campaign directory `out`.
+pub fn run_dir(out: &Path, label: &str) -> PathBuf {
+    out.join("runs").join(label)
+}
+
+/// The marker of a finished run (`done.json`), written last and atomically.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct DoneMarker {
+    /// Run label.
+    pub label: String,
+    /// Run index in the campaign.
+    pub index: usize,
+    /// Run status (`completed`).
+    pub status: String,
+    /// Steps.
+    pub steps: u64,
+    /// Simulated time (s).
+    pub simulated_time: f64,
+    /// Wall time of the run (s).
+    pub wall_seconds: f64,
+    /// Worker threads of the run.
+    pub threads: usize,
+    /// Samples in `probe.csv`.
+    pub samples: usize,
+    /// When it finished (seconds since the Unix epoch).
+    pub finished_unix: f64,
+    /// Solver version.
+    pub solver_version: String,
+    /// Notes of the scene builder (e.g. the fingers' initial back-off).
+    pub notes: Vec<String>,
+}
+
+/// The marker of a finished run in `dir`, if there is a readable one.
+pub fn read_done(dir: &Path) -> Option<DoneMarker> {
+    let s = std::fs::read_to_string(dir.join(DONE_FILE)).ok()?;
+    serde_json::from_str(&s).ok()
+}
+
+/// Mark the run in `dir` finished.
+pub fn write_done(dir: &Path, m: &DoneMarker) -> Result<(), String> {
+    let s = serde_json::to_string_pretty(m).map_err(|e| e.to_string())?;
+    write_atomic(&dir.join(DONE_FILE), s.as_bytes())
+}
+
+/// The samples of a finished run: `probe.csv` and `probe_stress.csv` of its hand `hand`.
+#[derive(Clone, Debug, Default)]
+pub struct RunSamples {
+    /// Sample times (s).
+    pub time: Vec<f64>,
+    /// Hand force along the pressing direction (N).
+    pub force: Vec<f64>,
+    /// Indentation since first contact (m): `hand_depth`.
+    pub depth: Vec<f64>,
+    /// ROI element ids.
+    pub elements: Vec<u32>,
+    /// Maximum principal stress (Pa), per sample per ROI element.
+    pub max_principal: Vec<Vec<f64>>,
+    /// Cauchy stress (Pa), per sample per ROI element, xx, yy, zz, xy, yz, zx.
+    pub tensors: Vec<Vec<[f64; 6]>>,
+}
+
+/// Read the samples of the finished run in `dir` (hand `hand`).
+pub fn read_run(dir: &Path) -> Result<RunSamples, String> {
+    let hand = "hand";
+    let p = read_probe(dir, hand)?;
+    let (cols, rows) = read_history(&dir.join("probe.csv"))?;
+    let depth = column(&cols, &rows, &format!("{hand}_depth"))
+        .ok_or_else(|| format!("{}: no column `{hand}_depth`", dir.join("probe.csv").display()))?;
+    let path = dir.join("probe_stress.csv");
+    let (tcols, trows) = read_history(&path)?;
+    if trows.len() != p.time.len() {
+        return Err(format!(
+            "{}: {} rows, probe.csv has {}",
+            path.display(),
+            trows.len(),
+            p.time.len()
+        ));
+    }
+    let mut idx = Vec::with_capacity(p.elements.len());
+    for e in &p.elements {
+        let mut k = [0usize; 6];
+        for (c, comp) in ["xx", "yy", "zz", "xy", "yz", "zx"].iter().enumerate() {
+            let name = format!("e{e}_{comp}");
+            k[c] = tcols
+                .iter()
+                .position(|x| *x == name)
+                .ok_or_else(|| format!("{}: no column `{name}`", path.display()))?;
+        }
+        idx.push(k);
+    }
+    let tensors = trows
+        .iter()
+        .map(|row| idx.iter().map(|k| k.map(|c| row[c])).collect())
+        .collect();
+    Ok(RunSamples {
+        time: p.time,
+        force: p.force,
+        depth,
+        elements: p.elements,
+        max_principal: p.stress,
+        tensors,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn default_is_the_paper_protocol() {
+        let c = Campaign::paper();
+        assert_eq!(c.runs.len(), 28);
+        assert_eq!(c.locations.iter().filter(|l| l.split == Split::Train).count(), 25);
+        assert_eq!(c.runs[0].label, "P01");
+        assert_eq!(c.runs[27].label, "C");
+        assert_eq!(c.samples_per_run(&c.runs[0]), 6);
+        assert_eq!(c.base.voxel, crate::phantom::DEFAULT_VOXEL);
+        assert!((c.runs[0].depth - 0.015).abs() < 1e-15 && (c.runs[0].duration - 0.025).abs() < 1e-15);
+    }
+
+    #[test]
+    fn shipped_paper_file_equals_the_default() {
+        let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes/campaign-paper.toml");
+        let c = CampaignSpec::load(&path).unwrap().resolve().unwrap();
+        assert_eq!(c, Campaign::paper());
+    }
+
+    #[test]
+    fn lists_points_rasters_and_speeds() {
+        let spec: CampaignSpec = toml::from_str(
+            r#"
+            [locations]
+            train = ["P07", ["-50 mm", "190 mm"], { name = "D", at = ["-40 mm", "0.2 m"] }]
+            test = ["a"]
+            [[locations.raster]]
+            center = ["-50 mm", "195 mm"]
+            spacing = ["10 mm", "10 mm"]
+            n = [2, 2]
+            split = "test"
+            [indentation]
+            depth = ["5 mm", "10 mm"]
+            speed = "1 m/s"
+            "#,
+        )
+        .unwrap();
+        let c = spec.resolve().unwrap();
+        let labels: Vec<&str> = c.locations.iter().map(|l| l.label.as_str()).collect();
+        assert_eq!(labels, ["P07", "at_-50_190", "D", "A", "R01", "R02", "R03", "R04"]);
+        match c.locations[4].place {
+            Place::At(x, y) => assert!((x + 0.055).abs() < 1e-12 && (y - 0.2).abs() < 1e-12),
+            ref p => panic!("{p:?}"),
+        }
+        assert_eq!(c.runs.len(), 16);
+        assert_eq!(c.runs[1].label, "P07_d10mm_t10ms");
+        assert!((c.runs[1].duration - 0.010).abs() < 1e-15);
+    }
+
+    #[test]
+    fn errors_name_the_problem() {
+        let e = toml::from_str::<CampaignSpec>("[indentation]\ndepth = \"5 ms\"\n").unwrap_err();
+        assert!(e.to_string().contains("length"), "{e}");
+        let e = toml::from_str::<CampaignSpec>("[phantom]\nvoxels = \"5 mm\"\n").unwrap_err();
+        assert!(e.to_string().contains("voxels"), "{e}");
+        let spec: CampaignSpec = toml::from_str("[locations]\ntrain = [\"A\"]\n").unwrap();
+        assert!(spec.resolve().unwrap_err().contains("twice"));
+        let spec: CampaignSpec = toml::from_str("[locations]\ntrain = [\"Q9\"]\n").unwrap();
+        assert!(spec.resolve().unwrap_err().contains("unknown location"));
+        assert_eq!(parse_shard("1/3").unwrap(), (1, 3));
+        assert!(parse_shard("3/3").is_err());
+    }
+}
