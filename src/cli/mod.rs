@@ -1,5 +1,6 @@
 //! Command-line parsing and dispatch.
 
+mod campaign;
 mod check;
 mod evaluate;
 mod material;
@@ -29,6 +30,9 @@ enum Command {
     /// The main job: press the two-finger hand 15 mm into the built-in abdomen phantom with the
     /// paper's materials, and write VTK frames, history, ROI stresses and plots into --out.
     Palpate(palpate::PalpateArgs),
+    /// Run a palpation campaign (the paper's protocol by default, or CAMPAIGN.toml) and write
+    /// the surrogate's training dataset (dataset.npz + manifest.json); `merge` joins shards.
+    Campaign(campaign::CampaignArgs),
     /// Run a scene and write VTK frames, history.csv and summary.json into --out.
     Run {
         /// The scene file (TOML).
@@ -121,6 +125,7 @@ pub fn dispatch(cli: Cli) -> Result<(), String> {
             set_threads(a.threads)?;
             palpate::palpate(&a)
         }
+        Command::Campaign(a) => campaign::campaign(&a),
         Command::Run {
             scene,
             out,

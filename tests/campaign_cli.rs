@@ -1,0 +1,207 @@
+//! `palpa campaign` end to end through the real binary (issue 7), on a tiny campaign (8 mm
+//! phantom, three locations, 2 mm in 1 ms, a sample every 0.5 ms: three runs of a few seconds):
+//! - the chain writes `dataset.npz` whose X / Y / S shapes are runs x samples, with the
+//!   locations, splits and sample times in run order;
+//! - two shards (`--shard 0/2`, `--shard 1/2`) merged give byte-identical dataset files to the
+//!   unsharded campaign;
+//! - a campaign killed after its first finished run and continued with `--resume` loses and
+//!   duplicates no run, does not recompute the finished one (its `done.json` is unchanged) and
+//!   redoes an unfinished run directory from scratch; without `--resume` it refuses to touch
+//!   the finished runs;
+//! - the shipped profiles (scenes/campaign-quick.toml, scenes/campaign-paper.toml) resolve on
+//!   their phantoms (`--dry-run`), and a bad key is an error naming it.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output, Stdio};
+use std::time::{Duration, Instant};
+use surrogate::Dataset;
+
+const TINY: &str = r#"
+title = "tiny"
+[phantom]
+voxel = "8 mm"
+[locations]
+train = ["P07", "P12"]
+test = ["A"]
+[indentation]
+depth = "2 mm"
+duration = "1 ms"
+sample_interval = "0.5 ms"
+"#;
+const RUNS: usize = 3;
+const SAMPLES: usize = 3;
+
+fn palpa(args: &[&str]) -> Output {
+    let out = Command::new(env!("CARGO_BIN_EXE_palpa"))
+        .args(args)
+        .output()
+        .unwrap();
+    assert!(
+        !String::from_utf8_lossy(&out.stderr).contains("panicked"),
+        "panic: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    out
+}
+
+fn ok(args: &[&str]) -> String {
+    let o = palpa(args);
+    let stdout = String::from_utf8_lossy(&o.stdout).into_owned();
+    assert!(
+        o.status.success(),
+        "palpa {args:?} failed: {}\n{stdout}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    stdout
+}
+
+fn tiny(dir: &Path) -> PathBuf {
+    let p = dir.join("tiny.toml");
+    std::fs::write(&p, TINY).unwrap();
+    p
+}
+
+fn s(p: &Path) -> &str {
+    p.to_str().unwrap()
+}
+
+fn done_count(out: &Path) -> usize {
+    std::fs::read_dir(out.join("runs"))
+        .map(|d| {
+            d.filter(|e| e.as_ref().unwrap().path().join("done.json").is_file())
+                .count()
+        })
+        .unwrap_or(0)
+}
+
+/// The dataset has RUNS x SAMPLES rows in run order: locations 0, 1, 2, splits train, train,
+/// test, times 0, 0.5, 1 ms within each run; no row lost or duplicated.
+fn check_dataset(out: &Path) -> Dataset {
+    let d = Dataset::read(out.join("dataset.npz")).unwrap();
+    let n = RUNS * SAMPLES;
+    let r = d.n_roi();
+    assert!(r > 10, "ROI of {r} elements");
+    assert_eq!(d.x.dim(), (n, 5));
+    assert_eq!(d.y.dim(), (n, r));
+    assert_eq!(d.stress.as_ref().unwrap().dim(), (n, r, 6));
+    assert_eq!(d.roi_ids.len(), r);
+    assert_eq!(d.roi_centroids.dim(), (r, 3));
+    assert_eq!(d.manifest.x_columns, ["x", "y", "force", "time", "depth"]);
+    assert_eq!(d.manifest.location_labels, ["P07", "P12", "A"]);
+    for i in 0..n {
+        let run = i / SAMPLES;
+        assert_eq!(d.location[i], run as i64, "row {i}");
+        assert_eq!(d.split[i], u8::from(run == 2), "row {i}");
+        let t = d.x[(i, 3)];
+        let want = (i % SAMPLES) as f64 * 0.5e-3;
+        assert!((t - want).abs() < 0.05e-3, "row {i}: time {t}, expected {want}");
+    }
+    // the fingers push in each run, and the ROI feels it
+    for run in 0..RUNS {
+        let rows = run * SAMPLES..(run + 1) * SAMPLES;
+        assert!(rows.clone().any(|i| d.x[(i, 2)] > 0.0), "run {run}: no force");
+        assert!(d.y.row(rows.end - 1).iter().any(|v| v.abs() > 0.0), "run {run}: no stress");
+    }
+    assert!(out.join("manifest.json").is_file() && out.join("dataset.json").is_file());
+    d
+}
+
+#[test]
+fn chain_and_two_shards_merged_equal_one_unsharded_run() {
+    let tmp = tempfile::tempdir().unwrap();
+    let file = tiny(tmp.path());
+    let full = tmp.path().join("full");
+    ok(&["campaign", s(&file), "--out", s(&full), "--quiet"]);
+    assert_eq!(done_count(&full), RUNS);
+    let d = check_dataset(&full);
+    assert_eq!(d.manifest.solver["version"], env!("CARGO_PKG_VERSION"));
+
+    let (s0, s1) = (tmp.path().join("s0"), tmp.path().join("s1"));
+    ok(&["campaign", s(&file), "--out", s(&s0), "--shard", "0/2", "--jobs", "1", "--quiet"]);
+    ok(&["campaign", s(&file), "--out", s(&s1), "--shard", "1/2", "--jobs", "1", "--quiet"]);
+    assert_eq!((done_count(&s0), done_count(&s1)), (2, 1));
+    // a merge that misses a shard names the missing runs
+    let o = palpa(&["campaign", "merge", s(&s0), "--out", s(&tmp.path().join("bad"))]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(!o.status.success() && err.contains("P12"), "{err}");
+
+    let merged = tmp.path().join("merged");
+    ok(&["campaign", "merge", s(&s0), s(&s1), "--out", s(&merged), "--quiet"]);
+    assert_eq!(done_count(&merged), RUNS);
+    for f in ["dataset.npz", "manifest.json", "dataset.json"] {
+        let a = std::fs::read(full.join(f)).unwrap();
+        let b = std::fs::read(merged.join(f)).unwrap();
+        assert!(a == b, "{f}: merged shards differ from the unsharded campaign");
+    }
+}
+
+#[test]
+fn killed_campaign_resumes_without_losing_or_repeating_runs() {
+    let tmp = tempfile::tempdir().unwrap();
+    let file = tiny(tmp.path());
+    let out = tmp.path().join("c");
+    let mut child = Command::new(env!("CARGO_BIN_EXE_palpa"))
+        .args(["campaign", s(&file), "--out", s(&out), "--jobs", "1", "--threads", "1", "--quiet"])
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap();
+    let t0 = Instant::now();
+    while done_count(&out) == 0 {
+        assert!(t0.elapsed() < Duration::from_secs(120), "no run finished");
+        assert!(child.try_wait().unwrap().is_none(), "the campaign ended early");
+        std::thread::sleep(Duration::from_millis(10));
+    }
+    child.kill().unwrap();
+    child.wait().unwrap();
+    let done = done_count(&out);
+    assert!((1..RUNS).contains(&done), "{done} runs finished before the kill");
+    let first = out.join("runs/P07/done.json");
+    let marker = std::fs::read(&first).unwrap();
+    assert!(!out.join("dataset.npz").exists());
+    // an unfinished run directory (as a kill mid-run leaves it) is redone from scratch
+    let partial = out.join("runs/A");
+    std::fs::create_dir_all(&partial).unwrap();
+    std::fs::write(partial.join("probe.csv"), "time\n0\n").unwrap();
+
+    // without --resume the finished runs are not touched
+    let o = palpa(&["campaign", s(&file), "--out", s(&out), "--quiet"]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(!o.status.success() && err.contains("--resume"), "{err}");
+
+    let stdout = ok(&["campaign", s(&file), "--out", s(&out), "--resume"]);
+    assert!(
+        stdout.contains(&format!("{done} finished, {} to run", RUNS - done)),
+        "{stdout}"
+    );
+    assert_eq!(stdout.matches("  done ").count(), RUNS - done, "{stdout}");
+    assert!(!stdout.contains("done P07"), "{stdout}");
+    assert_eq!(std::fs::read(&first).unwrap(), marker, "a finished run was recomputed");
+    assert_eq!(done_count(&out), RUNS);
+    check_dataset(&out);
+    // resuming a finished campaign runs nothing and rewrites the same dataset
+    let before = std::fs::read(out.join("dataset.npz")).unwrap();
+    let stdout = ok(&["campaign", s(&file), "--out", s(&out), "--resume"]);
+    assert!(stdout.contains(&format!("{RUNS} finished, 0 to run")), "{stdout}");
+    assert_eq!(std::fs::read(out.join("dataset.npz")).unwrap(), before);
+}
+
+#[test]
+fn shipped_profiles_resolve_and_bad_keys_are_named() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let quick = ok(&["campaign", s(&root.join("scenes/campaign-quick.toml")), "--dry-run"]);
+    assert!(quick.contains("5 runs (5 locations: 4 train, 1 test)"), "{quick}");
+    assert_eq!(quick.matches("to run").count(), 5, "{quick}");
+    let paper = ok(&["campaign", s(&root.join("scenes/campaign-paper.toml")), "--dry-run"]);
+    assert!(paper.contains("28 runs (28 locations: 25 train, 3 test)"), "{paper}");
+    assert!(paper.contains("voxel 5.0 mm"), "{paper}");
+
+    let tmp = tempfile::tempdir().unwrap();
+    let bad = tmp.path().join("bad.toml");
+    std::fs::write(&bad, "[indentation]\ndepht = \"5 mm\"\n").unwrap();
+    let o = palpa(&["campaign", s(&bad), "--dry-run"]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(!o.status.success() && err.contains("depht") && err.contains("bad.toml"), "{err}");
+    let o = palpa(&["campaign", "--shard", "2/2", "--dry-run"]);
+    assert!(!o.status.success());
+}
