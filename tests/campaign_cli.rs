@@ -94,13 +94,22 @@ fn check_dataset(out: &Path) -> Dataset {
         assert_eq!(d.split[i], u8::from(run == 2), "row {i}");
         let t = d.x[(i, 3)];
         let want = (i % SAMPLES) as f64 * 0.5e-3;
-        assert!((t - want).abs() < 0.05e-3, "row {i}: time {t}, expected {want}");
+        assert!(
+            (t - want).abs() < 0.05e-3,
+            "row {i}: time {t}, expected {want}"
+        );
     }
     // the fingers push in each run, and the ROI feels it
     for run in 0..RUNS {
         let rows = run * SAMPLES..(run + 1) * SAMPLES;
-        assert!(rows.clone().any(|i| d.x[(i, 2)] > 0.0), "run {run}: no force");
-        assert!(d.y.row(rows.end - 1).iter().any(|v| v.abs() > 0.0), "run {run}: no stress");
+        assert!(
+            rows.clone().any(|i| d.x[(i, 2)] > 0.0),
+            "run {run}: no force"
+        );
+        assert!(
+            d.y.row(rows.end - 1).iter().any(|v| v.abs() > 0.0),
+            "run {run}: no stress"
+        );
     }
     assert!(out.join("manifest.json").is_file() && out.join("dataset.json").is_file());
     d
@@ -117,21 +126,58 @@ fn chain_and_two_shards_merged_equal_one_unsharded_run() {
     assert_eq!(d.manifest.solver["version"], env!("CARGO_PKG_VERSION"));
 
     let (s0, s1) = (tmp.path().join("s0"), tmp.path().join("s1"));
-    ok(&["campaign", s(&file), "--out", s(&s0), "--shard", "0/2", "--jobs", "1", "--quiet"]);
-    ok(&["campaign", s(&file), "--out", s(&s1), "--shard", "1/2", "--jobs", "1", "--quiet"]);
+    ok(&[
+        "campaign",
+        s(&file),
+        "--out",
+        s(&s0),
+        "--shard",
+        "0/2",
+        "--jobs",
+        "1",
+        "--quiet",
+    ]);
+    ok(&[
+        "campaign",
+        s(&file),
+        "--out",
+        s(&s1),
+        "--shard",
+        "1/2",
+        "--jobs",
+        "1",
+        "--quiet",
+    ]);
     assert_eq!((done_count(&s0), done_count(&s1)), (2, 1));
     // a merge that misses a shard names the missing runs
-    let o = palpa(&["campaign", "merge", s(&s0), "--out", s(&tmp.path().join("bad"))]);
+    let o = palpa(&[
+        "campaign",
+        "merge",
+        s(&s0),
+        "--out",
+        s(&tmp.path().join("bad")),
+    ]);
     let err = String::from_utf8_lossy(&o.stderr);
     assert!(!o.status.success() && err.contains("P12"), "{err}");
 
     let merged = tmp.path().join("merged");
-    ok(&["campaign", "merge", s(&s0), s(&s1), "--out", s(&merged), "--quiet"]);
+    ok(&[
+        "campaign",
+        "merge",
+        s(&s0),
+        s(&s1),
+        "--out",
+        s(&merged),
+        "--quiet",
+    ]);
     assert_eq!(done_count(&merged), RUNS);
     for f in ["dataset.npz", "manifest.json", "dataset.json"] {
         let a = std::fs::read(full.join(f)).unwrap();
         let b = std::fs::read(merged.join(f)).unwrap();
-        assert!(a == b, "{f}: merged shards differ from the unsharded campaign");
+        assert!(
+            a == b,
+            "{f}: merged shards differ from the unsharded campaign"
+        );
     }
 }
 
@@ -141,7 +187,17 @@ fn killed_campaign_resumes_without_losing_or_repeating_runs() {
     let file = tiny(tmp.path());
     let out = tmp.path().join("c");
     let mut child = Command::new(env!("CARGO_BIN_EXE_palpa"))
-        .args(["campaign", s(&file), "--out", s(&out), "--jobs", "1", "--threads", "1", "--quiet"])
+        .args([
+            "campaign",
+            s(&file),
+            "--out",
+            s(&out),
+            "--jobs",
+            "1",
+            "--threads",
+            "1",
+            "--quiet",
+        ])
         .stdout(Stdio::null())
         .stderr(Stdio::null())
         .spawn()
@@ -149,13 +205,19 @@ fn killed_campaign_resumes_without_losing_or_repeating_runs() {
     let t0 = Instant::now();
     while done_count(&out) == 0 {
         assert!(t0.elapsed() < Duration::from_secs(120), "no run finished");
-        assert!(child.try_wait().unwrap().is_none(), "the campaign ended early");
+        assert!(
+            child.try_wait().unwrap().is_none(),
+            "the campaign ended early"
+        );
         std::thread::sleep(Duration::from_millis(10));
     }
     child.kill().unwrap();
     child.wait().unwrap();
     let done = done_count(&out);
-    assert!((1..RUNS).contains(&done), "{done} runs finished before the kill");
+    assert!(
+        (1..RUNS).contains(&done),
+        "{done} runs finished before the kill"
+    );
     let first = out.join("runs/P07/done.json");
     let marker = std::fs::read(&first).unwrap();
     assert!(!out.join("dataset.npz").exists());
@@ -176,24 +238,45 @@ fn killed_campaign_resumes_without_losing_or_repeating_runs() {
     );
     assert_eq!(stdout.matches("  done ").count(), RUNS - done, "{stdout}");
     assert!(!stdout.contains("done P07"), "{stdout}");
-    assert_eq!(std::fs::read(&first).unwrap(), marker, "a finished run was recomputed");
+    assert_eq!(
+        std::fs::read(&first).unwrap(),
+        marker,
+        "a finished run was recomputed"
+    );
     assert_eq!(done_count(&out), RUNS);
     check_dataset(&out);
     // resuming a finished campaign runs nothing and rewrites the same dataset
     let before = std::fs::read(out.join("dataset.npz")).unwrap();
     let stdout = ok(&["campaign", s(&file), "--out", s(&out), "--resume"]);
-    assert!(stdout.contains(&format!("{RUNS} finished, 0 to run")), "{stdout}");
+    assert!(
+        stdout.contains(&format!("{RUNS} finished, 0 to run")),
+        "{stdout}"
+    );
     assert_eq!(std::fs::read(out.join("dataset.npz")).unwrap(), before);
 }
 
 #[test]
 fn shipped_profiles_resolve_and_bad_keys_are_named() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    let quick = ok(&["campaign", s(&root.join("scenes/campaign-quick.toml")), "--dry-run"]);
-    assert!(quick.contains("5 runs (5 locations: 4 train, 1 test)"), "{quick}");
+    let quick = ok(&[
+        "campaign",
+        s(&root.join("scenes/campaign-quick.toml")),
+        "--dry-run",
+    ]);
+    assert!(
+        quick.contains("5 runs (5 locations: 4 train, 1 test)"),
+        "{quick}"
+    );
     assert_eq!(quick.matches("to run").count(), 5, "{quick}");
-    let paper = ok(&["campaign", s(&root.join("scenes/campaign-paper.toml")), "--dry-run"]);
-    assert!(paper.contains("28 runs (28 locations: 25 train, 3 test)"), "{paper}");
+    let paper = ok(&[
+        "campaign",
+        s(&root.join("scenes/campaign-paper.toml")),
+        "--dry-run",
+    ]);
+    assert!(
+        paper.contains("28 runs (28 locations: 25 train, 3 test)"),
+        "{paper}"
+    );
     assert!(paper.contains("voxel 5.0 mm"), "{paper}");
 
     let tmp = tempfile::tempdir().unwrap();
@@ -201,7 +284,10 @@ fn shipped_profiles_resolve_and_bad_keys_are_named() {
     std::fs::write(&bad, "[indentation]\ndepht = \"5 mm\"\n").unwrap();
     let o = palpa(&["campaign", s(&bad), "--dry-run"]);
     let err = String::from_utf8_lossy(&o.stderr);
-    assert!(!o.status.success() && err.contains("depht") && err.contains("bad.toml"), "{err}");
+    assert!(
+        !o.status.success() && err.contains("depht") && err.contains("bad.toml"),
+        "{err}"
+    );
     let o = palpa(&["campaign", "--shard", "2/2", "--dry-run"]);
     assert!(!o.status.success());
 }

@@ -88,7 +88,9 @@ impl<'de, T: serde::de::DeserializeOwned> Deserialize<'de> for OneOrMany<T> {
         let v = toml::Value::deserialize(d)?;
         let one = |x: toml::Value| T::deserialize(x).map_err(|e| D::Error::custom(e.message()));
         match v {
-            toml::Value::Array(a) => Ok(OneOrMany(a.into_iter().map(one).collect::<Result<_, _>>()?)),
+            toml::Value::Array(a) => {
+                Ok(OneOrMany(a.into_iter().map(one).collect::<Result<_, _>>()?))
+            }
             x => Ok(OneOrMany(vec![one(x)?])),
         }
     }
@@ -323,7 +325,9 @@ fn entry_locations(e: &LocationEntry, split: Split) -> Result<Vec<CampaignLocati
     Ok(match e {
         LocationEntry::Name(n) if n.eq_ignore_ascii_case("grid") => {
             let g = crate::phantom::GridParams::default();
-            (1..=g.n[0] * g.n[1]).map(|k| named(&format!("P{k:02}"))).collect()
+            (1..=g.n[0] * g.n[1])
+                .map(|k| named(&format!("P{k:02}")))
+                .collect()
         }
         LocationEntry::Name(n) => {
             let n = n.to_ascii_uppercase();
@@ -361,7 +365,11 @@ fn raster_locations(r: &RasterSpec) -> Result<(Split, Vec<CampaignLocation>), St
     let split = match r.split.as_str() {
         "train" => Split::Train,
         "test" => Split::Test,
-        o => return Err(format!("locations.raster: split `{o}` is not train or test")),
+        o => {
+            return Err(format!(
+                "locations.raster: split `{o}` is not train or test"
+            ))
+        }
     };
     let prefix = r.prefix.clone().unwrap_or_else(|| "R".into());
     check_label(&prefix)?;
@@ -369,7 +377,10 @@ fn raster_locations(r: &RasterSpec) -> Result<(Split, Vec<CampaignLocation>), St
     if nx == 0 || ny == 0 {
         return Err("locations.raster: n must be at least [1, 1]".into());
     }
-    let (c, s) = ([r.center[0].0, r.center[1].0], [r.spacing[0].0, r.spacing[1].0]);
+    let (c, s) = (
+        [r.center[0].0, r.center[1].0],
+        [r.spacing[0].0, r.spacing[1].0],
+    );
     let mut out = Vec::new();
     // cranial row first (largest y), each row from the patient's right (smallest x)
     for j in (0..ny).rev() {
@@ -391,7 +402,8 @@ impl CampaignSpec {
     pub fn load(path: &Path) -> Result<CampaignSpec, String> {
         let src = std::fs::read_to_string(path)
             .map_err(|e| format!("{}: cannot read the campaign file: {e}", path.display()))?;
-        toml::from_str(&src).map_err(|e| format!("{}: {}", path.display(), e.to_string().trim_end()))
+        toml::from_str(&src)
+            .map_err(|e| format!("{}: {}", path.display(), e.to_string().trim_end()))
     }
 
     /// Resolve into a campaign (checks values; the phantom is not built here).
@@ -483,11 +495,16 @@ impl CampaignSpec {
 
         let l = &self.locations;
         let default_train = vec![LocationEntry::Name("grid".into())];
-        let default_test: Vec<LocationEntry> =
-            ["A", "B", "C"].iter().map(|n| LocationEntry::Name(n.to_string())).collect();
+        let default_test: Vec<LocationEntry> = ["A", "B", "C"]
+            .iter()
+            .map(|n| LocationEntry::Name(n.to_string()))
+            .collect();
         let mut locations = Vec::new();
-        let rasters: Vec<(Split, Vec<CampaignLocation>)> =
-            l.raster.iter().map(raster_locations).collect::<Result<_, _>>()?;
+        let rasters: Vec<(Split, Vec<CampaignLocation>)> = l
+            .raster
+            .iter()
+            .map(raster_locations)
+            .collect::<Result<_, _>>()?;
         for (split, entries) in [
             (Split::Train, l.train.as_ref().unwrap_or(&default_train)),
             (Split::Test, l.test.as_ref().unwrap_or(&default_test)),
@@ -543,13 +560,18 @@ impl CampaignSpec {
             }
         }
         let c = Campaign {
-            title: self.title.clone().unwrap_or_else(|| "palpation campaign".into()),
+            title: self
+                .title
+                .clone()
+                .unwrap_or_else(|| "palpation campaign".into()),
             base,
             locations,
             runs,
         };
         for r in &c.runs {
-            c.setup(r).validate().map_err(|e| format!("run {}: {e}", r.label))?;
+            c.setup(r)
+                .validate()
+                .map_err(|e| format!("run {}: {e}", r.label))?;
         }
         Ok(c)
     }
@@ -583,7 +605,8 @@ impl Campaign {
     /// that a phantom built from them is reused by [`build_scene_with`]).
     pub fn phantom_params(&self) -> Result<PhantomParams, String> {
         let src = self.base.scene_toml();
-        let spec: SceneSpec = toml::from_str(&src).map_err(|e| format!("internal: campaign scene: {e}"))?;
+        let spec: SceneSpec =
+            toml::from_str(&src).map_err(|e| format!("internal: campaign scene: {e}"))?;
         spec.mesh.phantom.unwrap_or_default().to_params()
     }
 
@@ -593,24 +616,33 @@ impl Campaign {
         self.locations
             .iter()
             .map(|l| match &l.place {
-                Place::Named(n) => ph.locations.get(n).cloned().ok_or_else(|| {
-                    format!("location {n}: the phantom has no such location")
-                }),
-                Place::At(x, y) => location_at(&ph.mesh, &ph.skin_faces, &ph.volume, &l.label, *x, *y)
-                    .map_err(|e| format!("location {}: {e}", l.label)),
+                Place::Named(n) => ph
+                    .locations
+                    .get(n)
+                    .cloned()
+                    .ok_or_else(|| format!("location {n}: the phantom has no such location")),
+                Place::At(x, y) => {
+                    location_at(&ph.mesh, &ph.skin_faces, &ph.volume, &l.label, *x, *y)
+                        .map_err(|e| format!("location {}: {e}", l.label))
+                }
             })
             .collect()
     }
 
     /// Write run `r`'s `scene.toml` into `dir` and build it, reusing `phantom`.
-    pub fn build_run_scene(&self, r: &PlannedRun, dir: &Path, phantom: &Phantom) -> Result<Scene, String> {
+    pub fn build_run_scene(
+        &self,
+        r: &PlannedRun,
+        dir: &Path,
+        phantom: &Phantom,
+    ) -> Result<Scene, String> {
         std::fs::create_dir_all(dir)
             .map_err(|e| format!("{}: cannot create the run directory: {e}", dir.display()))?;
         let path = dir.join("scene.toml");
         let src = self.setup(r).scene_toml();
         write_atomic(&path, src.as_bytes())?;
-        let spec: SceneSpec =
-            toml::from_str(&src).map_err(|e| format!("{}: {}", path.display(), e.to_string().trim_end()))?;
+        let spec: SceneSpec = toml::from_str(&src)
+            .map_err(|e| format!("{}: {}", path.display(), e.to_string().trim_end()))?;
         build_scene_with(spec, &path, &src, Some(phantom.clone()))
     }
 
@@ -680,7 +712,10 @@ pub fn phantom_json(p: &PhantomParams) -> serde_json::Value {
 pub fn parse_shard(s: &str) -> Result<(usize, usize), String> {
     let bad = || format!("--shard: expected i/n with 0 <= i < n, e.g. 0/4, got `{s}`");
     let (i, n) = s.split_once('/').ok_or_else(bad)?;
-    let (i, n): (usize, usize) = (i.trim().parse().map_err(|_| bad())?, n.trim().parse().map_err(|_| bad())?);
+    let (i, n): (usize, usize) = (
+        i.trim().parse().map_err(|_| bad())?,
+        n.trim().parse().map_err(|_| bad())?,
+    );
     if n == 0 || i >= n {
         return Err(bad());
     }
@@ -758,8 +793,12 @@ pub fn read_run(dir: &Path) -> Result<RunSamples, String> {
     let hand = "hand";
     let p = read_probe(dir, hand)?;
     let (cols, rows) = read_history(&dir.join("probe.csv"))?;
-    let depth = column(&cols, &rows, &format!("{hand}_depth"))
-        .ok_or_else(|| format!("{}: no column `{hand}_depth`", dir.join("probe.csv").display()))?;
+    let depth = column(&cols, &rows, &format!("{hand}_depth")).ok_or_else(|| {
+        format!(
+            "{}: no column `{hand}_depth`",
+            dir.join("probe.csv").display()
+        )
+    })?;
     let path = dir.join("probe_stress.csv");
     let (tcols, trows) = read_history(&path)?;
     if trows.len() != p.time.len() {
@@ -804,12 +843,20 @@ mod tests {
     fn default_is_the_paper_protocol() {
         let c = Campaign::paper();
         assert_eq!(c.runs.len(), 28);
-        assert_eq!(c.locations.iter().filter(|l| l.split == Split::Train).count(), 25);
+        assert_eq!(
+            c.locations
+                .iter()
+                .filter(|l| l.split == Split::Train)
+                .count(),
+            25
+        );
         assert_eq!(c.runs[0].label, "P01");
         assert_eq!(c.runs[27].label, "C");
         assert_eq!(c.samples_per_run(&c.runs[0]), 6);
         assert_eq!(c.base.voxel, crate::phantom::DEFAULT_VOXEL);
-        assert!((c.runs[0].depth - 0.015).abs() < 1e-15 && (c.runs[0].duration - 0.025).abs() < 1e-15);
+        assert!(
+            (c.runs[0].depth - 0.015).abs() < 1e-15 && (c.runs[0].duration - 0.025).abs() < 1e-15
+        );
     }
 
     #[test]
@@ -841,7 +888,10 @@ mod tests {
         .unwrap();
         let c = spec.resolve().unwrap();
         let labels: Vec<&str> = c.locations.iter().map(|l| l.label.as_str()).collect();
-        assert_eq!(labels, ["P07", "at_-50_190", "D", "A", "R01", "R02", "R03", "R04"]);
+        assert_eq!(
+            labels,
+            ["P07", "at_-50_190", "D", "A", "R01", "R02", "R03", "R04"]
+        );
         match c.locations[4].place {
             Place::At(x, y) => assert!((x + 0.055).abs() < 1e-12 && (y - 0.2).abs() < 1e-12),
             ref p => panic!("{p:?}"),

@@ -131,7 +131,9 @@ fn campaign_file(plan: &Value, shard: Option<(usize, usize)>) -> Value {
 
 /// Number of cores.
 fn cores() -> usize {
-    std::thread::available_parallelism().map(|n| n.get()).unwrap_or(1)
+    std::thread::available_parallelism()
+        .map(|n| n.get())
+        .unwrap_or(1)
 }
 
 fn run_campaign(a: &CampaignArgs) -> Result<(), String> {
@@ -140,12 +142,10 @@ fn run_campaign(a: &CampaignArgs) -> Result<(), String> {
         Some(f) => CampaignSpec::load(f)?,
         None => CampaignSpec::default(),
     };
-    let campaign = spec
-        .resolve()
-        .map_err(|e| match &a.file {
-            Some(f) => format!("{}: {e}", f.display()),
-            None => e,
-        })?;
+    let campaign = spec.resolve().map_err(|e| match &a.file {
+        Some(f) => format!("{}: {e}", f.display()),
+        None => e,
+    })?;
     let shard = a.shard.as_deref().map(parse_shard).transpose()?;
     if a.jobs == Some(0) || a.threads == Some(0) {
         return Err("--jobs and --threads must be at least 1".into());
@@ -161,7 +161,10 @@ fn run_campaign(a: &CampaignArgs) -> Result<(), String> {
     let mine: Vec<&PlannedRun> = campaign
         .runs
         .iter()
-        .filter(|r| shard.map_or(true, |s| in_shard(r.index, s)))
+        .filter(|r| match shard {
+            Some(s) => in_shard(r.index, s),
+            None => true,
+        })
         .collect();
     let out = &a.out;
     let done: Vec<bool> = mine
@@ -302,7 +305,12 @@ fn run_campaign(a: &CampaignArgs) -> Result<(), String> {
     Ok(())
 }
 
-fn print_plan(c: &Campaign, locs: &[solver::phantom::Location], mine: &[&PlannedRun], done: &[bool]) {
+fn print_plan(
+    c: &Campaign,
+    locs: &[solver::phantom::Location],
+    mine: &[&PlannedRun],
+    done: &[bool],
+) {
     println!(
         "  {:<20} {:<8} {:<5} {:>8} {:>8} {:>8} {:>8} {:>9} {:>7}  state",
         "run", "location", "split", "x mm", "y mm", "liver mm", "depth mm", "time ms", "samples"
@@ -328,6 +336,10 @@ fn print_plan(c: &Campaign, locs: &[solver::phantom::Location], mine: &[&Planned
     }
 }
 
+/// Per job the (label, simulated time, end time) of its current run; the simulated time of the
+/// finished runs (s).
+type Slots = (Vec<Option<(String, f64, f64)>>, f64);
+
 /// What [`execute`] did.
 struct Report {
     finished: usize,
@@ -352,8 +364,8 @@ fn execute(
     let stop = stop_flag();
     let next = AtomicUsize::new(0);
     let finished = AtomicUsize::new(0);
-    // per job: (label, simulated time) of its current run; the time of finished runs
-    let slots: Mutex<(Vec<Option<(String, f64)>>, f64)> = Mutex::new((vec![None; jobs], 0.0));
+    // per job: (label, simulated time, end time) of its current run; the time of finished runs
+    let slots: Mutex<Slots> = Mutex::new((vec![None; jobs], 0.0));
     let failed: Mutex<Vec<(String, String)>> = Mutex::new(Vec::new());
     let run_seconds = Mutex::new(0.0f64);
     let n = todo.len();
@@ -365,14 +377,14 @@ fn execute(
             pb.println(line);
         }
     };
-    let update = |slots: &(Vec<Option<(String, f64)>>, f64)| {
+    let update = |slots: &Slots| {
         let pos = slots.1 + slots.0.iter().flatten().map(|s| s.1).sum::<f64>();
         pb.set_position((pos * 1e6) as u64);
         let cur: Vec<String> = slots
             .0
             .iter()
             .flatten()
-            .map(|(l, t)| format!("{l} {:.2} ms", t * 1e3))
+            .map(|(l, t, end)| format!("{l} {:.2}/{:.2} ms", t * 1e3, end * 1e3))
             .collect();
         pb.set_message(format!(
             "{}/{} runs; {}",
@@ -394,14 +406,14 @@ fn execute(
             let Some(&r) = todo.get(k) else { break };
             {
                 let mut s = slots.lock().unwrap();
-                s.0[slot] = Some((r.label.clone(), 0.0));
+                s.0[slot] = Some((r.label.clone(), 0.0, r.duration));
                 update(&s);
             }
             let t0 = Instant::now();
             let res = pool.install(|| {
                 run_one(c, r, out, phantom, &stop, &mut |t| {
                     let mut s = slots.lock().unwrap();
-                    s.0[slot] = Some((r.label.clone(), t));
+                    s.0[slot] = Some((r.label.clone(), t, r.duration));
                     update(&s);
                 })
             });
@@ -439,7 +451,10 @@ fn execute(
             .collect();
         handles
             .into_iter()
-            .map(|h| h.join().unwrap_or_else(|_| Err("a campaign worker panicked".into())))
+            .map(|h| {
+                h.join()
+                    .unwrap_or_else(|_| Err("a campaign worker panicked".into()))
+            })
             .collect()
     });
     pb.finish_and_clear();
@@ -503,7 +518,11 @@ fn bad_plan(what: &str) -> String {
 
 /// The dataset of the runs `labels` (in plan order) of campaign `plan`, reading run `l` from
 /// `dir_of(l)`. Used by both `palpa campaign` and `merge`, so the two write the same bytes.
-fn assemble(plan: &Value, labels: &[String], dir_of: impl Fn(&str) -> PathBuf) -> Result<Dataset, String> {
+fn assemble(
+    plan: &Value,
+    labels: &[String],
+    dir_of: impl Fn(&str) -> PathBuf,
+) -> Result<Dataset, String> {
     let arr = |v: &Value, what: &str| v.as_array().cloned().ok_or_else(|| bad_plan(what));
     let f = |v: &Value, what: &str| v.as_f64().ok_or_else(|| bad_plan(what));
     let s = |v: &Value, what: &str| v.as_str().map(str::to_string).ok_or_else(|| bad_plan(what));
@@ -524,7 +543,11 @@ fn assemble(plan: &Value, labels: &[String], dir_of: impl Fn(&str) -> PathBuf) -
     for l in arr(&plan["locations"], "locations")? {
         locs.push((
             s(&l["label"], "locations.label")?,
-            if s(&l["split"], "locations.split")? == "test" { 1u8 } else { 0 },
+            if s(&l["split"], "locations.split")? == "test" {
+                1u8
+            } else {
+                0
+            },
             f(&l["surface_m"][0], "locations.surface_m")?,
             f(&l["surface_m"][1], "locations.surface_m")?,
         ));
@@ -556,7 +579,10 @@ fn assemble(plan: &Value, labels: &[String], dir_of: impl Fn(&str) -> PathBuf) -
             .collect::<Option<_>>()
             .filter(|_| d.elements.len() == r)
             .ok_or_else(|| {
-                format!("{}: the probe's elements are not the campaign's ROI", dir.display())
+                format!(
+                    "{}: the probe's elements are not the campaign's ROI",
+                    dir.display()
+                )
             })?;
         let start = xs.len();
         for k in 0..d.time.len() {
@@ -579,7 +605,9 @@ fn assemble(plan: &Value, labels: &[String], dir_of: impl Fn(&str) -> PathBuf) -
     }
     let n = xs.len();
     let mut manifest = Manifest {
-        x_columns: ["x", "y", "force", "time", "depth"].map(String::from).to_vec(),
+        x_columns: ["x", "y", "force", "time", "depth"]
+            .map(String::from)
+            .to_vec(),
         location_labels: locs.iter().map(|l| l.0.clone()).collect(),
         solver: json!({
             "name": "palpa",
@@ -597,8 +625,12 @@ fn assemble(plan: &Value, labels: &[String], dir_of: impl Fn(&str) -> PathBuf) -
         }),
         ..Manifest::default()
     };
-    manifest.units.insert("location".into(), "index into location_labels".into());
-    manifest.units.insert("split".into(), "0 train, 1 test".into());
+    manifest
+        .units
+        .insert("location".into(), "index into location_labels".into());
+    manifest
+        .units
+        .insert("split".into(), "0 train, 1 test".into());
     let ds = Dataset {
         x: Array2::from_shape_vec((n, 5), xs.concat()).map_err(|e| e.to_string())?,
         y: Array2::from_shape_vec((n, r), ys).map_err(|e| e.to_string())?,
@@ -621,11 +653,15 @@ fn write_dataset(ds: &Dataset, out: &Path) -> Result<(), String> {
 
 fn print_dataset(ds: &Dataset, out: &Path, partial: bool) {
     let train = ds.rows_with_split(0).len();
-    let (lo, hi) = ds
-        .y
-        .iter()
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |a, &v| (a.0.min(v), a.1.max(v)));
-    let fmax = ds.x.column(2).iter().fold(f64::NEG_INFINITY, |a, &v| a.max(v));
+    let (lo, hi) =
+        ds.y.iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |a, &v| {
+                (a.0.min(v), a.1.max(v))
+            });
+    let fmax =
+        ds.x.column(2)
+            .iter()
+            .fold(f64::NEG_INFINITY, |a, &v| a.max(v));
     println!(
         "  dataset{}: {} samples ({} train, {} test) x {} ROI elements; force up to {:.2} N, stress {:.3} .. {:.3} kPa -> {}",
         if partial { " of this shard" } else { "" },
@@ -666,7 +702,10 @@ fn merge(dirs: &[PathBuf], out: &Path, quiet: bool) -> Result<(), String> {
     for d in dirs {
         let v = read_json(&d.join(CAMPAIGN_FILE))?;
         if v["format"] != CAMPAIGN_FORMAT {
-            return Err(format!("{}: not a palpa campaign", d.join(CAMPAIGN_FILE).display()));
+            return Err(format!(
+                "{}: not a palpa campaign",
+                d.join(CAMPAIGN_FILE).display()
+            ));
         }
         match &plan {
             None => plan = Some(v["plan"].clone()),
@@ -685,7 +724,12 @@ fn merge(dirs: &[PathBuf], out: &Path, quiet: bool) -> Result<(), String> {
         .as_array()
         .ok_or_else(|| bad_plan("runs"))?
         .iter()
-        .map(|r| r["label"].as_str().map(String::from).ok_or_else(|| bad_plan("runs.label")))
+        .map(|r| {
+            r["label"]
+                .as_str()
+                .map(String::from)
+                .ok_or_else(|| bad_plan("runs.label"))
+        })
         .collect::<Result<_, _>>()?;
     std::fs::create_dir_all(out).map_err(|e| format!("{}: {e}", out.display()))?;
     let same = |a: &Path, b: &Path| match (a.canonicalize(), b.canonicalize()) {
