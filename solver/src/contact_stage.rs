@@ -580,9 +580,14 @@ pub fn build_stage(
     // Largest penetration of each indenter at t = 0 over the face samples, as the stage sees it.
     let zeros = vec![[0.0; 3]; mesh.nodes.len()];
     let measure = |specs: &[IndenterSpec]| -> Result<Vec<f64>, String> {
-        let mut st =
-            ContactStage::new(specs, surface.clone(), &mesh.nodes, &model.mass, params.clone())
-                .map_err(|e| format!("{}: {e}", path.display()))?;
+        let mut st = ContactStage::new(
+            specs,
+            surface.clone(),
+            &mesh.nodes,
+            &model.mass,
+            params.clone(),
+        )
+        .map_err(|e| format!("{}: {e}", path.display()))?;
         let mut f = zeros.clone();
         st.apply(0.0, design_dt, &mesh.nodes, &zeros, &mut f);
         Ok(st.indenters().iter().map(|s| s.max_penetration).collect())

@@ -14,8 +14,8 @@
 //! (dt_t / (s_f L/c))^2, which raises its step to exactly dt_t; other elements are untouched.
 //! The added mass is reported per part.
 
-use crate::element::{Formulation, HourglassForm};
 use crate::element::max_face_area;
+use crate::element::{Formulation, HourglassForm};
 use crate::hex::{element_geometry, hourglass_gamma};
 use crate::mesh::Mesh;
 use material::Material;
@@ -305,9 +305,11 @@ impl Model {
                                     bb += b * b;
                                 }
                             }
-                            g.hg_scale.push(hg.coefficient * lambda2mu * bb / (3.0 * geo.volume) / 64.0);
+                            g.hg_scale
+                                .push(hg.coefficient * lambda2mu * bb / (3.0 * geo.volume) / 64.0);
                         } else {
-                            g.hg_scale.push(hg.coefficient * rho * geo.volume.powf(2.0 / 3.0) * 0.25);
+                            g.hg_scale
+                                .push(hg.coefficient * rho * geo.volume.powf(2.0 / 3.0) * 0.25);
                         }
                     }
                     Formulation::Full { .. } => {

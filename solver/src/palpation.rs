@@ -43,7 +43,9 @@ impl ElementChoice {
     /// Scene keys of the choice.
     fn scene_keys(&self) -> &'static str {
         match self {
-            ElementChoice::OnePointViscous => "formulation = \"one_point\", hourglass = \"viscous\"",
+            ElementChoice::OnePointViscous => {
+                "formulation = \"one_point\", hourglass = \"viscous\""
+            }
             ElementChoice::OnePointStiffness => {
                 "formulation = \"one_point\", hourglass = \"stiffness\""
             }
@@ -187,10 +189,15 @@ impl PalpationSetup {
         pos(self.finger_spacing, "finger spacing")?;
         pos(self.voxel, "voxel")?;
         if self.finger_spacing < self.finger_diameter {
-            return Err("the finger spacing (centre to centre) must be at least the diameter".into());
+            return Err(
+                "the finger spacing (centre to centre) must be at least the diameter".into(),
+            );
         }
         if !(self.dt_factor > 0.0 && self.dt_factor <= 1.0) {
-            return Err(format!("dt factor must lie in (0, 1], got {}", self.dt_factor));
+            return Err(format!(
+                "dt factor must lie in (0, 1], got {}",
+                self.dt_factor
+            ));
         }
         if let Some(t) = self.mass_scaling_dt {
             pos(t, "mass-scaling target step")?;
@@ -273,10 +280,18 @@ impl PalpationSetup {
             let _ = writeln!(s, "[materials.{n}]\n{}", scaled_liver_card(t.stiffness));
         }
         for (p, m) in &parts {
-            let _ = writeln!(s, "[[part]]\nname = {p:?}\nmaterial = {m:?}\n{}\n", el.replace(", ", "\n"));
+            let _ = writeln!(
+                s,
+                "[[part]]\nname = {p:?}\nmaterial = {m:?}\n{}\n",
+                el.replace(", ", "\n")
+            );
         }
         for n in &tumour_names {
-            let _ = writeln!(s, "[[part]]\nname = {n:?}\nmaterial = {n:?}\n{}\n", el.replace(", ", "\n"));
+            let _ = writeln!(
+                s,
+                "[[part]]\nname = {n:?}\nmaterial = {n:?}\n{}\n",
+                el.replace(", ", "\n")
+            );
         }
         s.push_str("[[boundary]]\nnodes = \"back\"\nfix = [\"all\"]\n\n");
         let rollers: &[(&str, &str)] = if self.variant == "full" {
@@ -344,7 +359,11 @@ pub fn read_probe(dir: &Path, hand: &str) -> Result<ProbeSamples, String> {
     let idx: Vec<(usize, u32)> = cols
         .iter()
         .enumerate()
-        .filter_map(|(i, c)| c.strip_prefix('e').and_then(|n| n.parse().ok()).map(|e| (i, e)))
+        .filter_map(|(i, c)| {
+            c.strip_prefix('e')
+                .and_then(|n| n.parse().ok())
+                .map(|e| (i, e))
+        })
         .collect();
     Ok(ProbeSamples {
         time,

@@ -329,10 +329,13 @@ pub fn run_scene(
                 } else {
                     Ok(())
                 };
-                if let Err(e) = written.and_then(|_| history.flush()).and_then(|_| match &probe {
-                    Some((p, pt)) => p.flush().and_then(|_| pt.flush()),
-                    None => Ok(()),
-                }) {
+                if let Err(e) = written
+                    .and_then(|_| history.flush())
+                    .and_then(|_| match &probe {
+                        Some((p, pt)) => p.flush().and_then(|_| pt.flush()),
+                        None => Ok(()),
+                    })
+                {
                     error = Some(e);
                     break;
                 }

@@ -73,6 +73,9 @@ fn force_control_reaches_and_holds_20_newton() {
         1e3 * depth.last().unwrap(),
         100.0 * emax
     );
-    assert!(worst < 0.02, "force deviates {:.2} % from 20 N", 100.0 * worst);
+    assert!(
+        worst < 0.02,
+        "force deviates {:.2} % from 20 N",
+        100.0 * worst
+    );
 }
-

@@ -36,7 +36,11 @@ fn flat_punch_force_matches_closed_form() {
             // Full depth: the end of the hold.
             4.0 * fz.last().unwrap()
         };
-        let g = if d < 0.1e-3 { at(&travel[..n], &pen[..n], d) } else { *pen.last().unwrap() };
+        let g = if d < 0.1e-3 {
+            at(&travel[..n], &pen[..n], d)
+        } else {
+            *pen.last().unwrap()
+        };
         let f_ref = 2.0 * a * es * d;
         let rel = (f - f_ref) / f_ref;
         worst = worst.max(rel.abs());

@@ -33,10 +33,16 @@ vtk = false
 "#;
 
 fn run(threads: usize, form: &str) -> (Vec<[f64; 3]>, f64) {
-    let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .unwrap();
     pool.install(|| {
         let mut scene: Scene = common::scene_from_str(&SCENE.replace("FORM", form));
-        assert!(scene.sim.model.mesh.elements.len() > 2 * solver::model::CHUNK, "needs several chunks");
+        assert!(
+            scene.sim.model.mesh.elements.len() > 2 * solver::model::CHUNK,
+            "needs several chunks"
+        );
         for _ in 0..100 {
             scene.sim.step(f64::INFINITY).unwrap();
         }
@@ -49,7 +55,12 @@ fn one_and_two_threads_give_identical_bits() {
     for form in ["one_point", "full_fbar"] {
         let (u1, e1) = run(1, form);
         let (u2, e2) = run(2, form);
-        assert!(u1.iter().zip(&u2).all(|(a, b)| a.iter().zip(b).all(|(x, y)| x.to_bits() == y.to_bits())), "{form}: displacements differ");
+        assert!(
+            u1.iter()
+                .zip(&u2)
+                .all(|(a, b)| a.iter().zip(b).all(|(x, y)| x.to_bits() == y.to_bits())),
+            "{form}: displacements differ"
+        );
         assert_eq!(e1.to_bits(), e2.to_bits(), "{form}: energies differ");
         assert!(e1 > 0.0);
     }

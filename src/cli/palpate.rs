@@ -99,12 +99,18 @@ impl PalpateArgs {
             s.voxel = units::length(v, "--voxel")?;
         }
         if !["reduced", "full"].contains(&self.variant.as_str()) {
-            return Err(format!("--variant: `{}` is not reduced or full", self.variant));
+            return Err(format!(
+                "--variant: `{}` is not reduced or full",
+                self.variant
+            ));
         }
         s.variant = self.variant.clone();
         s.fat_thickness = units::length(&self.fat, "--fat")?;
         s.respiratory_phase = self.phase;
-        s.element = self.element.parse::<ElementChoice>().map_err(|e| format!("--element: {e}"))?;
+        s.element = self
+            .element
+            .parse::<ElementChoice>()
+            .map_err(|e| format!("--element: {e}"))?;
         s.mass_scaling_dt = self
             .mass_scaling
             .as_deref()
@@ -137,7 +143,10 @@ pub fn palpate(args: &PalpateArgs) -> Result<(), String> {
         .as_ref()
         .ok_or("internal: the palpation scene has no phantom")?;
     write_atomic(&out.join("roi.csv"), ph.roi.to_csv().as_bytes())?;
-    write_atomic(&out.join("locations.json"), ph.locations.to_json().as_bytes())?;
+    write_atomic(
+        &out.join("locations.json"),
+        ph.locations.to_json().as_bytes(),
+    )?;
     let centroids = ph.roi.centroids.clone();
     if !args.quiet {
         println!(
@@ -195,7 +204,10 @@ fn postprocess(out: &Path, centroids: &[[f64; 3]]) -> Result<Post, String> {
         .max_by(|a, b| a.1.total_cmp(b.1))
         .ok_or("history.csv is empty")?;
     let probe = read_probe(out, "hand")?;
-    write_atomic(&out.join("roi_stress.csv"), roi_csv(&probe, centroids).as_bytes())?;
+    write_atomic(
+        &out.join("roi_stress.csv"),
+        roi_csv(&probe, centroids).as_bytes(),
+    )?;
     let series = verification::Series {
         plot: "force_indentation".into(),
         title: "two-finger palpation: force against indentation".into(),
@@ -203,7 +215,11 @@ fn postprocess(out: &Path, centroids: &[[f64; 3]]) -> Result<Post, String> {
         log: false,
         curves: vec![(
             "palpa".into(),
-            travel.iter().zip(&force).map(|(d, f)| (d * 1e3, *f)).collect(),
+            travel
+                .iter()
+                .zip(&force)
+                .map(|(d, f)| (d * 1e3, *f))
+                .collect(),
         )],
     };
     verification::plot::draw(&series, out)?;

@@ -14,8 +14,10 @@ pub fn study(quick: bool, out: &Path, quiet: bool) -> Result<(), String> {
     } else {
         let pb = ProgressBar::new(1);
         pb.set_style(
-            ProgressStyle::with_template("{spinner} [{elapsed_precise}] {bar:30} {pos}/{len} {msg} (ETA {eta})")
-                .map_err(|e| e.to_string())?,
+            ProgressStyle::with_template(
+                "{spinner} [{elapsed_precise}] {bar:30} {pos}/{len} {msg} (ETA {eta})",
+            )
+            .map_err(|e| e.to_string())?,
         );
         pb.enable_steady_tick(std::time::Duration::from_millis(200));
         pb
@@ -27,13 +29,20 @@ pub fn study(quick: bool, out: &Path, quiet: bool) -> Result<(), String> {
     })?;
     pb.finish_and_clear();
     let md = verification::study::to_markdown(&rows);
-    write_atomic(&out.join("study.csv"), verification::study::to_csv(&rows).as_bytes())?;
+    write_atomic(
+        &out.join("study.csv"),
+        verification::study::to_csv(&rows).as_bytes(),
+    )?;
     write_atomic(&out.join("study.md"), md.as_bytes())?;
     let files = verification::study::plots(&rows, out)?;
     println!("{md}");
     for r in rows.iter().filter(|r| r.status != "completed") {
         println!("  {} = {}: {}", r.knob, r.setting, r.status);
     }
-    println!("wrote study.csv, study.md, {} into {}", files.join(", "), out.display());
+    println!(
+        "wrote study.csv, study.md, {} into {}",
+        files.join(", "),
+        out.display()
+    );
     Ok(())
 }

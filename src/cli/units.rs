@@ -27,7 +27,9 @@ pub fn lengths(s: &str, n: usize, flag: &str) -> Result<Vec<f64>, String> {
         .map(|x| length(x, flag))
         .collect::<Result<_, _>>()?;
     if v.len() != n {
-        return Err(format!("{flag}: expected {n} comma-separated lengths, got `{s}`"));
+        return Err(format!(
+            "{flag}: expected {n} comma-separated lengths, got `{s}`"
+        ));
     }
     Ok(v)
 }

@@ -8,12 +8,21 @@ pub fn verify(hard: bool, out: &Path) -> Result<(), String> {
     eprintln!(
         "palpa verify{}: running {} ...",
         if hard { " --hard" } else { "" },
-        if hard { "the hard-case suite" } else { "the reference problems and closed forms" }
+        if hard {
+            "the hard-case suite"
+        } else {
+            "the reference problems and closed forms"
+        }
     );
     let v = verification::verify(hard, out, |name, secs| eprintln!("  {name}: {secs:.1} s"))?;
     println!("{}", v.table);
     println!("{}", verification::report::summary_line(&v.output.rows));
-    println!("wall time {:.1} s; wrote {} into {}", v.seconds, v.files.join(", "), out.display());
+    println!(
+        "wall time {:.1} s; wrote {} into {}",
+        v.seconds,
+        v.files.join(", "),
+        out.display()
+    );
     for w in &v.warnings {
         eprintln!("warning: {w}");
     }

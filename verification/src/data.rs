@@ -8,14 +8,25 @@ use serde_json::Value;
 use solver::mesh::Mesh;
 
 /// scikit-fem patch test.
-pub const PATCH_SKFEM: &str = include_str!(concat!(env!("CARGO_MANIFEST_DIR"), "/data/patch_skfem.json"));
+pub const PATCH_SKFEM: &str = include_str!(concat!(
+    env!("CARGO_MANIFEST_DIR"),
+    "/data/patch_skfem.json"
+));
 /// FEniCSx patch test.
-pub const PATCH_FENICSX: &str = include_str!(concat!(env!("CARGO_MANIFEST_DIR"), "/data/patch_fenicsx.json"));
+pub const PATCH_FENICSX: &str = include_str!(concat!(
+    env!("CARGO_MANIFEST_DIR"),
+    "/data/patch_fenicsx.json"
+));
 /// FEniCSx clamped neo-Hookean block.
-pub const BLOCK_FENICSX: &str = include_str!(concat!(env!("CARGO_MANIFEST_DIR"), "/data/block_fenicsx.json"));
+pub const BLOCK_FENICSX: &str = include_str!(concat!(
+    env!("CARGO_MANIFEST_DIR"),
+    "/data/block_fenicsx.json"
+));
 /// scikit-fem cantilever.
-pub const CANTILEVER_SKFEM: &str =
-    include_str!(concat!(env!("CARGO_MANIFEST_DIR"), "/data/cantilever_skfem.json"));
+pub const CANTILEVER_SKFEM: &str = include_str!(concat!(
+    env!("CARGO_MANIFEST_DIR"),
+    "/data/cantilever_skfem.json"
+));
 
 /// Parse one of the embedded files.
 pub fn parse(text: &str) -> Value {
@@ -39,12 +50,16 @@ pub fn at<'a>(v: &'a Value, path: &str) -> &'a Value {
 
 /// A number.
 pub fn f(v: &Value, path: &str) -> f64 {
-    at(v, path).as_f64().unwrap_or_else(|| panic!("`{path}` is not a number"))
+    at(v, path)
+        .as_f64()
+        .unwrap_or_else(|| panic!("`{path}` is not a number"))
 }
 
 /// A string.
 pub fn s<'a>(v: &'a Value, path: &str) -> &'a str {
-    at(v, path).as_str().unwrap_or_else(|| panic!("`{path}` is not a string"))
+    at(v, path)
+        .as_str()
+        .unwrap_or_else(|| panic!("`{path}` is not a string"))
 }
 
 /// An array of numbers.
@@ -75,7 +90,11 @@ pub fn vec3(v: &Value, path: &str) -> Vec<[f64; 3]> {
         .iter()
         .map(|r| {
             let r = r.as_array().unwrap();
-            [r[0].as_f64().unwrap(), r[1].as_f64().unwrap(), r[2].as_f64().unwrap()]
+            [
+                r[0].as_f64().unwrap(),
+                r[1].as_f64().unwrap(),
+                r[2].as_f64().unwrap(),
+            ]
         })
         .collect()
 }

@@ -52,7 +52,9 @@ pub struct HardRun {
 
 /// Load a library material.
 pub fn library(name: &str) -> Material {
-    material::named(name).and_then(|s| s.build(name)).expect("library material builds")
+    material::named(name)
+        .and_then(|s| s.build(name))
+        .expect("library material builds")
 }
 
 /// Run `sim` to `end` and watch the criteria; `watch` is called after every step.
@@ -65,7 +67,12 @@ pub fn run_explicit(sim: &mut Simulation, end: f64, mut watch: impl FnMut(&Simul
             break;
         }
         watch(sim);
-        if sim.step % 16 == 0 && sim.u.iter().any(|u| !(u[0].is_finite() && u[1].is_finite() && u[2].is_finite())) {
+        if sim.step % 16 == 0
+            && sim
+                .u
+                .iter()
+                .any(|u| !(u[0].is_finite() && u[1].is_finite() && u[2].is_finite()))
+        {
             r.nan = true;
             r.stop = Some(format!("NaN displacement at t = {:.6} ms", sim.time * 1e3));
             break;
@@ -88,15 +95,39 @@ pub fn judge(case: &str, r: &HardRun, extra: &str) -> Vec<Row> {
     let mut rows = Vec::new();
     if let Some(stop) = &r.stop {
         let named = r.named && stop.contains("element") && stop.contains("t =");
-        let mut row = Row::with_error(case, "run outcome", "named stop (element, time)", f64::NAN, r.time, f64::NAN, None)
-            .detail(format!("{stop}{extra}"));
-        row.status = if named { Status::NamedStop } else { Status::Fail };
+        let mut row = Row::with_error(
+            case,
+            "run outcome",
+            "named stop (element, time)",
+            f64::NAN,
+            r.time,
+            f64::NAN,
+            None,
+        )
+        .detail(format!("{stop}{extra}"));
+        row.status = if named {
+            Status::NamedStop
+        } else {
+            Status::Fail
+        };
         rows.push(row);
         return rows;
     }
     rows.push(
-        Row::with_error(case, "max energy error", "energy balance", 0.0, r.energy_error, r.energy_error, Some(ENERGY_LIMIT))
-            .detail(format!("{} steps to t = {:.3} ms{extra}", r.steps, r.time * 1e3)),
+        Row::with_error(
+            case,
+            "max energy error",
+            "energy balance",
+            0.0,
+            r.energy_error,
+            r.energy_error,
+            Some(ENERGY_LIMIT),
+        )
+        .detail(format!(
+            "{} steps to t = {:.3} ms{extra}",
+            r.steps,
+            r.time * 1e3
+        )),
     );
     rows.push(Row::with_error(
         case,
@@ -110,22 +141,48 @@ pub fn judge(case: &str, r: &HardRun, extra: &str) -> Vec<Row> {
     rows
 }
 
-fn sim(mesh: Mesh, mat: Material, form: Formulation, c: Vec<Constraint>) -> Result<Simulation, String> {
-    let part = Part { name: mesh.part_names[0].clone(), material: mat, formulation: form };
+fn sim(
+    mesh: Mesh,
+    mat: Material,
+    form: Formulation,
+    c: Vec<Constraint>,
+) -> Result<Simulation, String> {
+    let part = Part {
+        name: mesh.part_names[0].clone(),
+        material: mat,
+        formulation: form,
+    };
     let model = Model::build(mesh, vec![part], None, 0.9).map_err(|e| e.to_string())?;
-    Simulation::new(model, LoopSettings::default(), c, Vec::new(), None, false).map_err(|e| e.to_string())
+    Simulation::new(model, LoopSettings::default(), c, Vec::new(), None, false)
+        .map_err(|e| e.to_string())
 }
 
 fn fixed(nodes: &[u32], dof: usize) -> Constraint {
-    Constraint { nodes: nodes.to_vec(), dof, kind: Kinematic::Fixed }
+    Constraint {
+        nodes: nodes.to_vec(),
+        dof,
+        kind: Kinematic::Fixed,
+    }
 }
 
 fn disp(nodes: &[u32], dof: usize, curve: Curve) -> Constraint {
-    Constraint { nodes: nodes.to_vec(), dof, kind: Kinematic::Displacement(curve) }
+    Constraint {
+        nodes: nodes.to_vec(),
+        dof,
+        kind: Kinematic::Displacement(curve),
+    }
 }
 
 fn boxm(size: [f64; 3], div: [usize; 3], part: &str) -> Mesh {
-    box_mesh(&BoxSpec { size, divisions: div, ..Default::default() }, part).expect("box")
+    box_mesh(
+        &BoxSpec {
+            size,
+            divisions: div,
+            ..Default::default()
+        },
+        part,
+    )
+    .expect("box")
 }
 
 fn push_run(out: &mut CaseOutput, case: &str, r: Result<HardRun, String>, extra: &str) {
@@ -142,7 +199,16 @@ pub fn flesh_compression(form: Formulation) -> Result<HardRun, String> {
     let mut c: Vec<Constraint> = (0..3).map(|d| fixed(&ns["zmin"], d)).collect();
     c.push(fixed(&ns["zmax"], 0));
     c.push(fixed(&ns["zmax"], 1));
-    c.push(disp(&ns["zmax"], 2, Curve::SmoothStep { t0: 0.0, t1: 0.02, from: 0.0, to: -0.003 }));
+    c.push(disp(
+        &ns["zmax"],
+        2,
+        Curve::SmoothStep {
+            t0: 0.0,
+            t1: 0.02,
+            from: 0.0,
+            to: -0.003,
+        },
+    ));
     let mut s = sim(m, library("paper:flesh"), form, c)?;
     Ok(run_explicit(&mut s, 0.025, |_| {}))
 }
@@ -156,7 +222,11 @@ pub fn liver_stretches() -> Result<HardRun, String> {
         fixed(&ns["xmin"], 0),
         fixed(&ns["ymin"], 1),
         fixed(&ns["zmin"], 2),
-        disp(&ns["zmax"], 2, Curve::Table(vec![(0.0, 0.0), (0.1, -0.5 * h), (0.2, 0.6 * h)])),
+        disp(
+            &ns["zmax"],
+            2,
+            Curve::Table(vec![(0.0, 0.0), (0.1, -0.5 * h), (0.2, 0.6 * h)]),
+        ),
     ];
     let mut s = sim(m, library("paper:liver"), ONE_POINT_VISCOUS, c)?;
     Ok(run_explicit(&mut s, 0.2, |_| {}))
@@ -166,7 +236,10 @@ pub fn liver_stretches() -> Result<HardRun, String> {
 pub fn patch_indentation(v: f64) -> Result<HardRun, String> {
     let m = boxm([0.04, 0.04, 0.02], [16, 16, 8], "flesh");
     let ns = m.node_sets.clone();
-    let patch: Vec<u32> = m.nodes_in_box([0.015 - 1e-9, 0.015 - 1e-9, 0.02 - 1e-9], [0.025 + 1e-9, 0.025 + 1e-9, 0.02 + 1e-9]);
+    let patch: Vec<u32> = m.nodes_in_box(
+        [0.015 - 1e-9, 0.015 - 1e-9, 0.02 - 1e-9],
+        [0.025 + 1e-9, 0.025 + 1e-9, 0.02 + 1e-9],
+    );
     let depth = 0.006;
     let t_ramp = 0.2 * depth / v; // reach speed v smoothly over the first 10 % of the depth
     let t_end = depth / v + 0.5 * t_ramp;
@@ -186,14 +259,26 @@ pub fn patch_indentation(v: f64) -> Result<HardRun, String> {
 pub fn ribs_bending() -> Result<(HardRun, f64), String> {
     let m = boxm([0.08, 0.01, 0.01], [24, 3, 3], "ribs");
     let ns = m.node_sets.clone();
-    let mid: Vec<u32> = m.nodes_in_box([0.04 - 1e-9, -1.0, 0.01 - 1e-9], [0.04 + 1e-9, 1.0, 0.01 + 1e-9]);
+    let mid: Vec<u32> = m.nodes_in_box(
+        [0.04 - 1e-9, -1.0, 0.01 - 1e-9],
+        [0.04 + 1e-9, 1.0, 0.01 + 1e-9],
+    );
     let mut c: Vec<Constraint> = Vec::new();
     for set in ["xmin", "xmax"] {
         for d in 0..3 {
             c.push(fixed(&ns[set], d));
         }
     }
-    c.push(disp(&mid, 2, Curve::SmoothStep { t0: 0.0, t1: 0.02, from: 0.0, to: -0.006 }));
+    c.push(disp(
+        &mid,
+        2,
+        Curve::SmoothStep {
+            t0: 0.0,
+            t1: 0.02,
+            from: 0.0,
+            to: -0.006,
+        },
+    ));
     let mat = library("paper:ribs");
     let names = mat.history_names();
     let mut s = sim(m, mat, FULL_FBAR, c)?;
@@ -201,7 +286,12 @@ pub fn ribs_bending() -> Result<(HardRun, f64), String> {
     let k = names.iter().position(|n| n == "eps_p");
     let stride = names.len();
     let eps_max = match k {
-        Some(k) if stride > 0 => s.model.groups[0].history.iter().skip(k).step_by(stride).fold(0.0f64, |a, &b| a.max(b)),
+        Some(k) if stride > 0 => s.model.groups[0]
+            .history
+            .iter()
+            .skip(k)
+            .step_by(stride)
+            .fold(0.0f64, |a, &b| a.max(b)),
         _ => f64::NAN,
     };
     Ok((r, eps_max))
@@ -216,9 +306,17 @@ pub fn inversion() -> Result<HardRun, String> {
     let others: Vec<u32> = ns["zmin"].clone();
     let mut c: Vec<Constraint> = (0..3).map(|d| fixed(&others, d)).collect();
     for d in 0..3 {
-        c.push(disp(&[corner], d, Curve::Table(vec![(0.0, 0.0), (0.01, -1.5 * h)])));
+        c.push(disp(
+            &[corner],
+            d,
+            Curve::Table(vec![(0.0, 0.0), (0.01, -1.5 * h)]),
+        ));
     }
-    let mat = Material::NeoHookean(NeoHookean { rho: 1000.0, lambda: 1.5e6, mu: 1e6 });
+    let mat = Material::NeoHookean(NeoHookean {
+        rho: 1000.0,
+        lambda: 1.5e6,
+        mu: 1e6,
+    });
     let mut s = sim(m, mat, Formulation::Full { fbar: false }, c)?;
     Ok(run_explicit(&mut s, 0.01, |_| {}))
 }
@@ -226,7 +324,10 @@ pub fn inversion() -> Result<HardRun, String> {
 /// Instantaneous Poisson ratio of the liver law (material driver, jump to stretch 0.99):
 /// (observed, closed form) for `prony_on`.
 pub fn liver_poisson(prony_on: &str) -> Result<(f64, f64), String> {
-    let card = material::library::LIVER.replace("prony_on = \"green_lagrange\"", &format!("prony_on = \"{prony_on}\""));
+    let card = material::library::LIVER.replace(
+        "prony_on = \"green_lagrange\"",
+        &format!("prony_on = \"{prony_on}\""),
+    );
     let text = format!(
         "mode = \"uniaxial_stress\"\n[[segment]]\nramp_to = 0.999\nduration = 0\nsteps = 1\n[material]\n{card}"
     );
@@ -237,10 +338,18 @@ pub fn liver_poisson(prony_on: &str) -> Result<(f64, f64), String> {
     let nu = -(ly[n] - 1.0) / (l[n] - 1.0);
     let mat = library("paper:liver");
     let (k, g, gsum) = match &mat {
-        Material::Ogden(o) => (o.bulk, o.mu0(), o.prony().iter().map(|t| t.modulus).sum::<f64>()),
+        Material::Ogden(o) => (
+            o.bulk,
+            o.mu0(),
+            o.prony().iter().map(|t| t.modulus).sum::<f64>(),
+        ),
         _ => return Err("paper:liver is not Ogden".into()),
     };
-    let (kin, gin) = if prony_on == "deviatoric" { (k, g + gsum) } else { (k + 2.0 / 3.0 * gsum, g + gsum) };
+    let (kin, gin) = if prony_on == "deviatoric" {
+        (k, g + gsum)
+    } else {
+        (k + 2.0 / 3.0 * gsum, g + gsum)
+    };
     Ok((nu, (3.0 * kin - 2.0 * gin) / (2.0 * (3.0 * kin + gin))))
 }
 
@@ -254,10 +363,22 @@ pub fn liver_negative_poisson_block() -> Result<(HardRun, f64), String> {
         fixed(&ns["xmin"], 0),
         fixed(&ns["ymin"], 1),
         fixed(&ns["zmin"], 2),
-        disp(&ns["zmax"], 2, Curve::SmoothStep { t0: 0.0, t1: 0.002, from: 0.0, to: -0.05 * h }),
+        disp(
+            &ns["zmax"],
+            2,
+            Curve::SmoothStep {
+                t0: 0.0,
+                t1: 0.002,
+                from: 0.0,
+                to: -0.05 * h,
+            },
+        ),
     ];
-    let card = material::library::LIVER.replace("prony_on = \"green_lagrange\"", "prony_on = \"deviatoric\"");
-    let mat = toml::from_str::<material::MaterialSpec>(&card).map_err(|e| e.to_string())?.build("liver")?;
+    let card = material::library::LIVER
+        .replace("prony_on = \"green_lagrange\"", "prony_on = \"deviatoric\"");
+    let mat = toml::from_str::<material::MaterialSpec>(&card)
+        .map_err(|e| e.to_string())?
+        .build("liver")?;
     let xmax = ns["xmax"].clone();
     let mut s = sim(m, mat, ONE_POINT_VISCOUS, c)?;
     let r = run_explicit(&mut s, 0.003, |_| {});
@@ -296,7 +417,8 @@ pub fn run_contact_scene(scene: &str, tag: &str, name: &str) -> Result<SceneRun,
         Ok(SceneRun {
             force: fz.last().copied().unwrap_or(f64::NAN).abs(),
             energy_error: summary.max_energy_error,
-            hourglass_ratio: summary.hourglass_energy.abs() / summary.internal_energy.abs().max(1e-300),
+            hourglass_ratio: summary.hourglass_energy.abs()
+                / summary.internal_energy.abs().max(1e-300),
         })
     })();
     let _ = std::fs::remove_dir_all(&dir);
@@ -345,9 +467,19 @@ fields = ["displacement"]
 pub fn run() -> CaseOutput {
     let mut out = CaseOutput::default();
     for form in [ONE_POINT_VISCOUS, FULL_FBAR] {
-        push_run(&mut out, &format!("flesh K/G 5e4, 30 % compression, {}", short(&form)), flesh_compression(form), "");
+        push_run(
+            &mut out,
+            &format!("flesh K/G 5e4, 30 % compression, {}", short(&form)),
+            flesh_compression(form),
+            "",
+        );
     }
-    push_run(&mut out, "liver law, stretch 1 -> 0.5 -> 1.6 (200 ms)", liver_stretches(), "");
+    push_run(
+        &mut out,
+        "liver law, stretch 1 -> 0.5 -> 1.6 (200 ms)",
+        liver_stretches(),
+        "",
+    );
     for v in [1.0, 5.0] {
         push_run(
             &mut out,
@@ -358,7 +490,11 @@ pub fn run() -> CaseOutput {
     }
     match ribs_bending() {
         Ok((r, eps)) => {
-            out.rows.extend(judge("ribs yielding, 3-point bending 6 mm", &r, &format!("; max eps_p = {eps:.3e}")));
+            out.rows.extend(judge(
+                "ribs yielding, 3-point bending 6 mm",
+                &r,
+                &format!("; max eps_p = {eps:.3e}"),
+            ));
             out.rows.push(Row::with_error(
                 "ribs yielding, 3-point bending 6 mm",
                 "max plastic strain eps_p (must be > 0)",
@@ -372,14 +508,23 @@ pub fn run() -> CaseOutput {
                 out.rows.last_mut().unwrap().status = Status::Fail;
             }
         }
-        Err(e) => out.rows.push(Row::failed("ribs yielding", "run outcome", e)),
+        Err(e) => out
+            .rows
+            .push(Row::failed("ribs yielding", "run outcome", e)),
     }
-    push_run(&mut out, "element driven towards inversion (corner through the face)", inversion(), "");
+    push_run(
+        &mut out,
+        "element driven towards inversion (corner through the face)",
+        inversion(),
+        "",
+    );
     let case = "finger (R 1 mm) smaller than an element (5 mm)";
     match run_contact_scene(SMALL_FINGER_SCENE, "small-finger", "finger") {
-        Err(e) if e.contains("not implemented") => {
-            out.rows.push(Row::not_yet(case, "run outcome", format!("needs the solver's contact stage ({e})")))
-        }
+        Err(e) if e.contains("not implemented") => out.rows.push(Row::not_yet(
+            case,
+            "run outcome",
+            format!("needs the solver's contact stage ({e})"),
+        )),
         Err(e) => {
             let named = e.contains("element") && e.contains("t =");
             let mut row = Row::failed(case, "run outcome", e);
@@ -389,8 +534,16 @@ pub fn run() -> CaseOutput {
             out.rows.push(row)
         }
         Ok(r) => {
-            let hr = HardRun { energy_error: r.energy_error, hourglass_ratio: r.hourglass_ratio, ..Default::default() };
-            out.rows.extend(judge(case, &hr, &format!("; finger force {:.3e} N", r.force)));
+            let hr = HardRun {
+                energy_error: r.energy_error,
+                hourglass_ratio: r.hourglass_ratio,
+                ..Default::default()
+            };
+            out.rows.extend(judge(
+                case,
+                &hr,
+                &format!("; finger force {:.3e} N", r.force),
+            ));
         }
     }
     for p in ["deviatoric", "green_lagrange"] {
@@ -412,9 +565,21 @@ pub fn run() -> CaseOutput {
         Ok((r, nu)) => {
             let case = "liver (deviatoric Prony) block, 5 % in 2 ms";
             out.rows.extend(judge(case, &r, ""));
-            out.rows.push(Row::with_error(case, "apparent Poisson ratio -e_x/e_z at 3 ms", "negative expected", f64::NAN, nu, f64::NAN, None));
+            out.rows.push(Row::with_error(
+                case,
+                "apparent Poisson ratio -e_x/e_z at 3 ms",
+                "negative expected",
+                f64::NAN,
+                nu,
+                f64::NAN,
+                None,
+            ));
         }
-        Err(e) => out.rows.push(Row::failed("liver negative Poisson block", "run outcome", e)),
+        Err(e) => out.rows.push(Row::failed(
+            "liver negative Poisson block",
+            "run outcome",
+            e,
+        )),
     }
     out
 }

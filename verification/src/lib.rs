@@ -74,14 +74,38 @@ pub struct Case {
 /// The default suite, in report order.
 pub fn default_suite() -> Vec<Case> {
     vec![
-        Case { name: "patch tests", run: cases::patch::run },
-        Case { name: "roller block", run: cases::block::roller },
-        Case { name: "clamped block", run: cases::block::clamped },
-        Case { name: "cantilever", run: cases::cantilever::run },
-        Case { name: "closed forms (laws)", run: cases::closed::laws },
-        Case { name: "wave speed", run: cases::closed::wave },
-        Case { name: "free vibration", run: cases::closed::vibration },
-        Case { name: "Hertz contact", run: cases::closed::hertz },
+        Case {
+            name: "patch tests",
+            run: cases::patch::run,
+        },
+        Case {
+            name: "roller block",
+            run: cases::block::roller,
+        },
+        Case {
+            name: "clamped block",
+            run: cases::block::clamped,
+        },
+        Case {
+            name: "cantilever",
+            run: cases::cantilever::run,
+        },
+        Case {
+            name: "closed forms (laws)",
+            run: cases::closed::laws,
+        },
+        Case {
+            name: "wave speed",
+            run: cases::closed::wave,
+        },
+        Case {
+            name: "free vibration",
+            run: cases::closed::vibration,
+        },
+        Case {
+            name: "Hertz contact",
+            run: cases::closed::hertz,
+        },
     ]
 }
 
@@ -120,11 +144,18 @@ impl Verification {
 
 /// Run the default suite (or the hard-case suite), write `report.md` (or `hard-report.md`)
 /// and the plots into `out`, and return the table.
-pub fn verify(hard: bool, out: &std::path::Path, progress: impl FnMut(&str, f64)) -> Result<Verification, String> {
+pub fn verify(
+    hard: bool,
+    out: &std::path::Path,
+    progress: impl FnMut(&str, f64),
+) -> Result<Verification, String> {
     std::fs::create_dir_all(out).map_err(|e| format!("cannot create `{}`: {e}", out.display()))?;
     let t0 = std::time::Instant::now();
     let cases = if hard {
-        vec![Case { name: "hard cases", run: hard::run }]
+        vec![Case {
+            name: "hard cases",
+            run: hard::run,
+        }]
     } else {
         default_suite()
     };
@@ -141,11 +172,20 @@ pub fn verify(hard: bool, out: &std::path::Path, progress: impl FnMut(&str, f64)
     let (title, name) = if hard {
         ("palpa verify --hard: hard-case suite", "hard-report.md")
     } else {
-        ("palpa verify: reference problems and closed forms", "report.md")
+        (
+            "palpa verify: reference problems and closed forms",
+            "report.md",
+        )
     };
     let md = report::markdown(title, &output, &files, seconds);
     report::write_atomic(&out.join(name), md.as_bytes())?;
     files.insert(0, name.to_string());
     let table = report::text_table(&output.rows);
-    Ok(Verification { output, table, files, warnings, seconds })
+    Ok(Verification {
+        output,
+        table,
+        files,
+        warnings,
+        seconds,
+    })
 }

@@ -54,14 +54,18 @@ pub fn draw(s: &Series, dir: &Path) -> Result<String, String> {
                 let data: Vec<(f64, f64)> = c
                     .iter()
                     .copied()
-                    .filter(|p| p.0.is_finite() && p.1.is_finite() && (!s.log || (p.0 > 0.0 && p.1 > 0.0)))
+                    .filter(|p| {
+                        p.0.is_finite() && p.1.is_finite() && (!s.log || (p.0 > 0.0 && p.1 > 0.0))
+                    })
                     .collect();
                 let many = data.len() > 40;
                 chart
                     .draw_series(LineSeries::new(data.clone(), col.stroke_width(2)))
                     .map_err(|x| e(&x))?
                     .label(label.as_str())
-                    .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], col.stroke_width(2)));
+                    .legend(move |(x, y)| {
+                        PathElement::new(vec![(x, y), (x + 20, y)], col.stroke_width(2))
+                    });
                 if !many {
                     chart
                         .draw_series(data.iter().map(|p| Circle::new(*p, 4, col.filled())))
@@ -77,13 +81,19 @@ pub fn draw(s: &Series, dir: &Path) -> Result<String, String> {
         }};
     }
     let mut builder = ChartBuilder::on(&root);
-    builder.caption(s.title.as_str(), ("sans-serif", 22)).margin(15).x_label_area_size(45).y_label_area_size(70);
+    builder
+        .caption(s.title.as_str(), ("sans-serif", 22))
+        .margin(15)
+        .x_label_area_size(45)
+        .y_label_area_size(70);
     if s.log {
         body!(builder
             .build_cartesian_2d((x0..x1).log_scale(), (y0..y1).log_scale())
             .map_err(|x| e(&x))?);
     } else {
-        body!(builder.build_cartesian_2d(x0..x1, y0..y1).map_err(|x| e(&x))?);
+        body!(builder
+            .build_cartesian_2d(x0..x1, y0..y1)
+            .map_err(|x| e(&x))?);
     }
     root.present().map_err(|x| e(&x))?;
     Ok(name)

@@ -29,7 +29,11 @@ pub struct Relaxed {
 /// A one-part model.
 pub fn model(mesh: Mesh, material: Material, formulation: Formulation) -> Result<Model, String> {
     let part = Part {
-        name: mesh.part_names.first().cloned().unwrap_or_else(|| "body".into()),
+        name: mesh
+            .part_names
+            .first()
+            .cloned()
+            .unwrap_or_else(|| "body".into()),
         material,
         formulation,
     };
@@ -77,8 +81,8 @@ pub fn relax(
         ..Default::default()
     };
     let t0 = Instant::now();
-    let mut sim =
-        Simulation::new(model, settings, constraints, loads, None, false).map_err(|e| e.to_string())?;
+    let mut sim = Simulation::new(model, settings, constraints, loads, None, false)
+        .map_err(|e| e.to_string())?;
     let mut converged = false;
     while sim.step < max_steps {
         sim.step(f64::INFINITY).map_err(|e| e.to_string())?;
@@ -99,5 +103,7 @@ pub fn relax(
 
 /// Largest |component| of a field.
 pub fn max_abs(u: &[[f64; 3]]) -> f64 {
-    u.iter().flat_map(|u| u.iter()).fold(0.0f64, |m, x| m.max(x.abs()))
+    u.iter()
+        .flat_map(|u| u.iter())
+        .fold(0.0f64, |m, x| m.max(x.abs()))
 }

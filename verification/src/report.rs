@@ -99,7 +99,11 @@ impl Row {
     }
 
     /// A row for a case that could not run.
-    pub fn failed(case: impl Into<String>, quantity: impl Into<String>, why: impl Into<String>) -> Row {
+    pub fn failed(
+        case: impl Into<String>,
+        quantity: impl Into<String>,
+        why: impl Into<String>,
+    ) -> Row {
         Row {
             case: case.into(),
             quantity: quantity.into(),
@@ -114,7 +118,11 @@ impl Row {
     }
 
     /// A row for a case whose feature does not exist yet.
-    pub fn not_yet(case: impl Into<String>, quantity: impl Into<String>, why: impl Into<String>) -> Row {
+    pub fn not_yet(
+        case: impl Into<String>,
+        quantity: impl Into<String>,
+        why: impl Into<String>,
+    ) -> Row {
         Row {
             status: Status::NotYet,
             ..Row::failed(case, quantity, why)
@@ -159,8 +167,14 @@ fn err(x: f64) -> String {
 /// The table's cells, header first.
 pub fn cells(rows: &[Row]) -> Vec<[String; 8]> {
     let mut out = vec![[
-        "case", "quantity", "reference source", "reference value", "palpa value", "error",
-        "tolerance", "pass",
+        "case",
+        "quantity",
+        "reference source",
+        "reference value",
+        "palpa value",
+        "error",
+        "tolerance",
+        "pass",
     ]
     .map(String::from)];
     for r in rows {
@@ -189,7 +203,9 @@ pub fn text_table(rows: &[Row]) -> String {
     }
     let mut s = String::new();
     for (i, r) in c.iter().enumerate() {
-        let line: Vec<String> = (0..8).map(|k| format!("{:<width$}", r[k], width = w[k])).collect();
+        let line: Vec<String> = (0..8)
+            .map(|k| format!("{:<width$}", r[k], width = w[k]))
+            .collect();
         s.push_str(line.join("  ").trim_end());
         s.push('\n');
         if i == 0 {
@@ -202,7 +218,14 @@ pub fn text_table(rows: &[Row]) -> String {
     if !details.is_empty() {
         s.push('\n');
         for r in details {
-            let _ = writeln!(s, "[{}] {} / {}: {}", r.status.label(), r.case, r.quantity, r.detail);
+            let _ = writeln!(
+                s,
+                "[{}] {} / {}: {}",
+                r.status.label(),
+                r.case,
+                r.quantity,
+                r.detail
+            );
         }
     }
     s
@@ -241,7 +264,11 @@ pub fn summary_line(rows: &[Row]) -> String {
 pub fn markdown(title: &str, out: &CaseOutput, plots: &[String], wall_seconds: f64) -> String {
     let mut s = String::new();
     let _ = writeln!(s, "# {title}\n");
-    let _ = writeln!(s, "{} (wall time {wall_seconds:.1} s).\n", summary_line(&out.rows));
+    let _ = writeln!(
+        s,
+        "{} (wall time {wall_seconds:.1} s).\n",
+        summary_line(&out.rows)
+    );
     let c = cells(&out.rows);
     let esc = |x: &str| x.replace('|', "\\|");
     for (i, r) in c.iter().enumerate() {
@@ -255,7 +282,14 @@ pub fn markdown(title: &str, out: &CaseOutput, plots: &[String], wall_seconds: f
     if !details.is_empty() {
         let _ = writeln!(s, "\n## Details\n");
         for r in details {
-            let _ = writeln!(s, "- **{}** ({}), {}: {}", r.case, r.status.label(), r.quantity, r.detail);
+            let _ = writeln!(
+                s,
+                "- **{}** ({}), {}: {}",
+                r.case,
+                r.status.label(),
+                r.quantity,
+                r.detail
+            );
         }
     }
     if !out.notes.is_empty() {

@@ -392,7 +392,11 @@ pub fn recommendation(rows: &[StudyRow]) -> String {
                 );
             }
             None => {
-                let _ = writeln!(s, "- no setting reaches a force error of {:.0} %.", 100.0 * tol);
+                let _ = writeln!(
+                    s,
+                    "- no setting reaches a force error of {:.0} %.",
+                    100.0 * tol
+                );
             }
         }
     }
@@ -405,7 +409,11 @@ pub fn plots(rows: &[StudyRow], out: &Path) -> Result<Vec<String>, String> {
     for (which, title) in [("force", "force error"), ("stress", "ROI stress error")] {
         let mut curves: Vec<(String, Vec<(f64, f64)>)> = Vec::new();
         for r in rows.iter().filter(|r| r.wall > 0.0) {
-            let e = if which == "force" { r.force_error } else { r.stress_error };
+            let e = if which == "force" {
+                r.force_error
+            } else {
+                r.stress_error
+            };
             let e = e.max(1e-6);
             match curves.iter_mut().find(|c| c.0 == r.knob) {
                 Some(c) => c.1.push((r.wall, e)),

@@ -14,8 +14,8 @@
 //! Without F-bar: f_a = sum_gp w detJ P g_a.
 
 use super::{
-    add_nodal_forces, bulk_pressure, cofactor, critical_step, deformation_gradient, gradient_rate, max_face_area, sym6,
-    ElementOut, Nodal, StepInput,
+    add_nodal_forces, bulk_pressure, cofactor, critical_step, deformation_gradient, gradient_rate,
+    max_face_area, sym6, ElementOut, Nodal, StepInput,
 };
 use material::{Law, LawError, Mat3};
 

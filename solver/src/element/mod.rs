@@ -218,9 +218,21 @@ pub fn add_nodal_forces(fe: &mut Nodal, p: &Mat3, g: &Nodal, w: f64) {
 pub fn max_face_area(x: &Nodal) -> f64 {
     let mut amax: f64 = 0.0;
     for f in crate::mesh::FACES.iter() {
-        let d1 = [x[0][f[2]] - x[0][f[0]], x[1][f[2]] - x[1][f[0]], x[2][f[2]] - x[2][f[0]]];
-        let d2 = [x[0][f[3]] - x[0][f[1]], x[1][f[3]] - x[1][f[1]], x[2][f[3]] - x[2][f[1]]];
-        let c = [d1[1] * d2[2] - d1[2] * d2[1], d1[2] * d2[0] - d1[0] * d2[2], d1[0] * d2[1] - d1[1] * d2[0]];
+        let d1 = [
+            x[0][f[2]] - x[0][f[0]],
+            x[1][f[2]] - x[1][f[0]],
+            x[2][f[2]] - x[2][f[0]],
+        ];
+        let d2 = [
+            x[0][f[3]] - x[0][f[1]],
+            x[1][f[3]] - x[1][f[1]],
+            x[2][f[3]] - x[2][f[1]],
+        ];
+        let c = [
+            d1[1] * d2[2] - d1[2] * d2[1],
+            d1[2] * d2[0] - d1[0] * d2[2],
+            d1[0] * d2[1] - d1[1] * d2[0],
+        ];
         amax = amax.max(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]);
     }
     0.5 * amax.sqrt()

@@ -5,8 +5,8 @@
 //! qdot_ialpha = sum_a v_ia gamma_alpha,a (FB 1981 eq. 32).
 
 use super::{
-    add_nodal_forces, bulk_pressure, cofactor, critical_step, deformation_gradient, dot8, gradient_rate,
-    max_face_area, sym6, ElementOut, HourglassForm, Nodal, StepInput,
+    add_nodal_forces, bulk_pressure, cofactor, critical_step, deformation_gradient, dot8,
+    gradient_rate, max_face_area, sym6, ElementOut, HourglassForm, Nodal, StepInput,
 };
 use material::{Law, LawError};
 
@@ -47,7 +47,11 @@ pub fn compute_forces<L: Law>(
     let c = resp.wave_speed / density_scale.sqrt();
     let vol = j * r.vol0;
     let l = vol / max_face_area(x);
-    let mut out = ElementOut { law_dissipation: resp.dissipation * r.vol0, failed: resp.failed, ..Default::default() };
+    let mut out = ElementOut {
+        law_dissipation: resp.dissipation * r.vol0,
+        failed: resp.failed,
+        ..Default::default()
+    };
     let mut qterm = 0.0;
     let mut q = 0.0;
     if let Some(bv) = input.bulk.as_ref() {

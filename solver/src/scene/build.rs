@@ -1,16 +1,16 @@
 //! Build a [`Scene`] (model, simulation, output plan) from a [`SceneSpec`].
 
+use super::contact_spec::HandScene;
 use super::spec::*;
 use crate::bc::{Constraint, Kinematic, NodalLoad};
 use crate::curve::Curve;
 use crate::element::{BulkViscosity, Formulation, Hourglass, HourglassForm};
 use crate::generate::{box_mesh, BoxSpec};
 use crate::mesh::Mesh;
-use crate::phantom::Phantom;
-use super::contact_spec::HandScene;
-use material::quantity::Length;
 use crate::model::{MassScaling, Model, Part};
+use crate::phantom::Phantom;
 use crate::simulation::{DynamicRelaxation, LoopSettings, Simulation};
+use material::quantity::Length;
 use material::Material;
 use std::path::{Path, PathBuf};
 
@@ -282,7 +282,11 @@ pub fn build_scene_with(
     if !(end_time > 0.0) {
         return Err(e("run.end_time", Some("end_time"), &"must be positive"));
     }
-    let dt_factor = spec.run.dt_factor.map(|x| x.0).unwrap_or(crate::simulation::DEFAULT_DT_FACTOR);
+    let dt_factor = spec
+        .run
+        .dt_factor
+        .map(|x| x.0)
+        .unwrap_or(crate::simulation::DEFAULT_DT_FACTOR);
     if !(dt_factor > 0.0 && dt_factor <= 1.0) {
         return Err(e(
             "run.dt_factor",
@@ -674,14 +678,23 @@ fn place_hand(h: &mut HandScene, phantom: Option<&Phantom>) -> Result<(), String
             return Err("give `point`, or `location`/`at`, not both".into());
         }
         (Some(name), None) => {
-            let ph = phantom.ok_or("`location` needs a phantom mesh (`generator = \"phantom\"`)")?;
-            ph.locations.get(name).cloned().ok_or_else(|| {
-                format!("no palpation location `{name}` (A, B, C, P01..P25)")
-            })?
+            let ph =
+                phantom.ok_or("`location` needs a phantom mesh (`generator = \"phantom\"`)")?;
+            ph.locations
+                .get(name)
+                .cloned()
+                .ok_or_else(|| format!("no palpation location `{name}` (A, B, C, P01..P25)"))?
         }
         (None, Some(xy)) => {
             let ph = phantom.ok_or("`at` needs a phantom mesh (`generator = \"phantom\"`)")?;
-            crate::phantom::location_at(&ph.mesh, &ph.skin_faces, &ph.volume, "at", xy[0].0, xy[1].0)?
+            crate::phantom::location_at(
+                &ph.mesh,
+                &ph.skin_faces,
+                &ph.volume,
+                "at",
+                xy[0].0,
+                xy[1].0,
+            )?
         }
     };
     h.point = Some(loc.surface.map(Length));

@@ -72,13 +72,27 @@ pub fn roller_block(form: solver::element::Formulation) -> Result<(f64, f64, f64
         on(&ns["zmin"], 2, None),
         on(&ns["zmax"], 2, Some(-strain * side)),
     ];
-    let mat = Material::NeoHookean(NeoHookean { rho: 1000.0, lambda, mu });
+    let mat = Material::NeoHookean(NeoHookean {
+        rho: 1000.0,
+        lambda,
+        mu,
+    });
     let r = relax(model(m, mat, form)?, c, Vec::new(), 1e-12, 100_000)?;
     if !r.converged {
-        return Err(format!("relaxation: residual {:.2e} after {} steps", r.residual, r.steps));
+        return Err(format!(
+            "relaxation: residual {:.2e} after {} steps",
+            r.residual, r.steps
+        ));
     }
-    let reaction: f64 = ns["zmax"].iter().map(|&n| r.sim.reaction[n as usize][2]).sum();
-    let ux = ns["xmax"].iter().map(|&n| r.sim.u[n as usize][0]).sum::<f64>() / ns["xmax"].len() as f64;
+    let reaction: f64 = ns["zmax"]
+        .iter()
+        .map(|&n| r.sim.reaction[n as usize][2])
+        .sum();
+    let ux = ns["xmax"]
+        .iter()
+        .map(|&n| r.sim.u[n as usize][0])
+        .sum::<f64>()
+        / ns["xmax"].len() as f64;
     let (l, p) = uniaxial_neo_hookean(mu, lambda, 1.0 - strain);
     Ok((reaction, p * side * side, ux, (l - 1.0) * side))
 }
@@ -86,13 +100,34 @@ pub fn roller_block(form: solver::element::Formulation) -> Result<(f64, f64, f64
 /// Roller-block rows.
 pub fn roller() -> CaseOutput {
     let mut out = CaseOutput::default();
-    for form in [super::ONE_POINT_VISCOUS, ONE_POINT_STIFFNESS, FULL_FBAR, FULL] {
+    for form in [
+        super::ONE_POINT_VISCOUS,
+        ONE_POINT_STIFFNESS,
+        FULL_FBAR,
+        FULL,
+    ] {
         let case = format!("roller block 20 %, {}", short(&form));
         let src = "closed form (homogeneous uniaxial stress)";
         match roller_block(form) {
             Ok((r, rw, ux, uxw)) => {
-                out.rows.push(Row::compare(&case, "top reaction F_z (N)", src, rw, r, rw, Some(ROLLER_TOLERANCE)));
-                out.rows.push(Row::compare(&case, "lateral displacement u_x (m)", src, uxw, ux, uxw, Some(ROLLER_TOLERANCE)));
+                out.rows.push(Row::compare(
+                    &case,
+                    "top reaction F_z (N)",
+                    src,
+                    rw,
+                    r,
+                    rw,
+                    Some(ROLLER_TOLERANCE),
+                ));
+                out.rows.push(Row::compare(
+                    &case,
+                    "lateral displacement u_x (m)",
+                    src,
+                    uxw,
+                    ux,
+                    uxw,
+                    Some(ROLLER_TOLERANCE),
+                ));
             }
             Err(e) => out.rows.push(Row::failed(&case, "top reaction F_z (N)", e)),
         }
@@ -120,10 +155,17 @@ pub fn clamped_level(
         on(&top, 1, None),
         on(&top, 2, Some(uz)),
     ];
-    let mat = Material::NeoHookean(NeoHookean { rho: 1000.0, lambda, mu });
+    let mat = Material::NeoHookean(NeoHookean {
+        rho: 1000.0,
+        lambda,
+        mu,
+    });
     let r = relax(model(m, mat, form)?, c, Vec::new(), tolerance, 400_000)?;
     if !r.converged {
-        return Err(format!("relaxation: residual {:.2e} after {} steps", r.residual, r.steps));
+        return Err(format!(
+            "relaxation: residual {:.2e} after {} steps",
+            r.residual, r.steps
+        ));
     }
     let fz: f64 = top.iter().map(|&n| r.sim.reaction[n as usize][2]).sum();
     let bulge = r.sim.u[at(level, "bulge_node").as_u64().unwrap() as usize][0];
@@ -131,7 +173,9 @@ pub fn clamped_level(
 }
 
 fn rate(e: &[f64]) -> Vec<f64> {
-    e.windows(2).map(|w| (w[0] / w[1]).ln() / 2f64.ln()).collect()
+    e.windows(2)
+        .map(|w| (w[0] / w[1]).ln() / 2f64.ln())
+        .collect()
 }
 
 /// Clamped-block rows, notes and the convergence plot.
@@ -139,20 +183,29 @@ pub fn clamped() -> CaseOutput {
     let v = data::parse(data::BLOCK_FENICSX);
     let (mu, lambda) = (f(&v, "material.mu"), f(&v, "material.lambda"));
     let levels = at(&v, "levels").as_array().unwrap();
-    let (q2_f, q2_u) = (f(&v, "reference.reaction_force_z"), f(&v, "reference.bulge_displacement_x"));
+    let (q2_f, q2_u) = (
+        f(&v, "reference.reaction_force_z"),
+        f(&v, "reference.bulge_displacement_x"),
+    );
     let lx = f(&v, "geometry.lx");
     let mut out = CaseOutput::default();
     let mut series_f = Series {
         plot: "block_convergence_force".into(),
         title: "Clamped block: reaction force error vs Q2 16x16x8".into(),
-        axes: ("element size h (mm)".into(), "|F_z - F_z,Q2| / |F_z,Q2|".into()),
+        axes: (
+            "element size h (mm)".into(),
+            "|F_z - F_z,Q2| / |F_z,Q2|".into(),
+        ),
         log: true,
         curves: Vec::new(),
     };
     let mut series_u = Series {
         plot: "block_convergence_bulge".into(),
         title: "Clamped block: bulge error vs Q2 16x16x8".into(),
-        axes: ("element size h (mm)".into(), "|u_x - u_x,Q2| / |u_x,Q2|".into()),
+        axes: (
+            "element size h (mm)".into(),
+            "|u_x - u_x,Q2| / |u_x,Q2|".into(),
+        ),
         log: true,
         curves: Vec::new(),
     };
@@ -162,8 +215,14 @@ pub fn clamped() -> CaseOutput {
     for lv in levels {
         let n = vec_u32(lv, "divisions")[0] as f64;
         let h = lx / n * 1e3;
-        fx_f.push((h, (f(lv, "solution.reaction_force_z") - q2_f).abs() / q2_f.abs()));
-        fx_u.push((h, (f(lv, "solution.bulge_displacement_x") - q2_u).abs() / q2_u.abs()));
+        fx_f.push((
+            h,
+            (f(lv, "solution.reaction_force_z") - q2_f).abs() / q2_f.abs(),
+        ));
+        fx_u.push((
+            h,
+            (f(lv, "solution.bulge_displacement_x") - q2_u).abs() / q2_u.abs(),
+        ));
     }
     for r in at(&v, "references").as_array().unwrap() {
         if s(r, "name").starts_with("Q1") {
@@ -196,9 +255,26 @@ pub fn clamped() -> CaseOutput {
             let dr_tol = if form == FULL { 1e-10 } else { 1e-8 };
             match clamped_level(lv, form, mu, lambda, dr_tol) {
                 Ok((fz, ux, steps, secs)) => {
-                    out.rows.push(Row::compare(&case, "plate reaction F_z (N)", &src, rf, fz, rf, tol));
-                    out.rows.push(Row::compare(&case, "bulge u_x at (20,10,5) mm (m)", &src, ru, ux, ru, tol));
-                    out.notes.push(format!("{case}: {steps} relaxation steps, {secs:.1} s"));
+                    out.rows.push(Row::compare(
+                        &case,
+                        "plate reaction F_z (N)",
+                        &src,
+                        rf,
+                        fz,
+                        rf,
+                        tol,
+                    ));
+                    out.rows.push(Row::compare(
+                        &case,
+                        "bulge u_x at (20,10,5) mm (m)",
+                        &src,
+                        ru,
+                        ux,
+                        ru,
+                        tol,
+                    ));
+                    out.notes
+                        .push(format!("{case}: {steps} relaxation steps, {secs:.1} s"));
                     let n = vec_u32(lv, "divisions")[0] as f64;
                     let h = lx / n * 1e3;
                     ef.push((fz - q2_f).abs() / q2_f.abs());
@@ -208,16 +284,39 @@ pub fn clamped() -> CaseOutput {
                     if k == finest {
                         let src = "FEniCSx Q2 16x16x8 (converged)";
                         let case = format!("clamped block {name}, {} vs Q2", short(&form));
-                        out.rows.push(Row::compare(&case, "plate reaction F_z (N)", src, q2_f, fz, q2_f, None));
-                        out.rows.push(Row::compare(&case, "bulge u_x (m)", src, q2_u, ux, q2_u, None));
+                        out.rows.push(Row::compare(
+                            &case,
+                            "plate reaction F_z (N)",
+                            src,
+                            q2_f,
+                            fz,
+                            q2_f,
+                            None,
+                        ));
+                        out.rows.push(Row::compare(
+                            &case,
+                            "bulge u_x (m)",
+                            src,
+                            q2_u,
+                            ux,
+                            q2_u,
+                            None,
+                        ));
                     }
                 }
-                Err(e) => out.rows.push(Row::failed(&case, "plate reaction F_z (N)", e)),
+                Err(e) => out
+                    .rows
+                    .push(Row::failed(&case, "plate reaction F_z (N)", e)),
             }
         }
         if ef.len() == levels.len() {
             let (rf, ru) = (rate(&ef), rate(&eu));
-            let fmt = |r: &[f64]| r.iter().map(|x| format!("{x:.2}")).collect::<Vec<_>>().join(", ");
+            let fmt = |r: &[f64]| {
+                r.iter()
+                    .map(|x| format!("{x:.2}"))
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            };
             out.notes.push(format!(
                 "clamped block, {}: errors vs Q2 (4x4x2, 8x8x4, 16x16x8): force {}, bulge {}; observed rates: force {}, bulge {}",
                 short(&form),
@@ -246,8 +345,12 @@ pub fn clamped() -> CaseOutput {
                 None,
             ));
         }
-        series_f.curves.push((format!("palpa {}", short(&form)), pts_f));
-        series_u.curves.push((format!("palpa {}", short(&form)), pts_u));
+        series_f
+            .curves
+            .push((format!("palpa {}", short(&form)), pts_f));
+        series_u
+            .curves
+            .push((format!("palpa {}", short(&form)), pts_u));
     }
     out.series.push(series_f);
     out.series.push(series_u);

@@ -29,7 +29,12 @@ use solver::element::Formulation;
 pub const Q1_TOLERANCE: f64 = 1e-5;
 
 /// palpa's tip deflection (m) on one stored mesh, and the relaxation steps.
-pub fn tip_deflection(m: &serde_json::Value, form: Formulation, lambda: f64, mu: f64) -> Result<(f64, u64), String> {
+pub fn tip_deflection(
+    m: &serde_json::Value,
+    form: Formulation,
+    lambda: f64,
+    mu: f64,
+) -> Result<(f64, u64), String> {
     let mesh = mesh(m, "mesh", "beam");
     let clamp = vec_u32(m, "boundary_conditions.clamped.nodes");
     let c = (0..3).map(|d| on(&clamp, d, None)).collect();
@@ -39,14 +44,26 @@ pub fn tip_deflection(m: &serde_json::Value, form: Formulation, lambda: f64, mu:
     for (&n, v) in ln.iter().zip(&lv) {
         for d in 0..3 {
             if v[d] != 0.0 {
-                loads.push(NodalLoad { nodes: vec![n], dof: d, curve: Curve::Constant(v[d]) });
+                loads.push(NodalLoad {
+                    nodes: vec![n],
+                    dof: d,
+                    curve: Curve::Constant(v[d]),
+                });
             }
         }
     }
-    let mat = Material::LinearElastic(LinearElastic { rho: 1000.0, lambda, mu, kinematics: Kinematics::Small });
+    let mat = Material::LinearElastic(LinearElastic {
+        rho: 1000.0,
+        lambda,
+        mu,
+        kinematics: Kinematics::Small,
+    });
     let r = relax(model(mesh, mat, form)?, c, loads, 1e-10, 600_000)?;
     if !r.converged {
-        return Err(format!("relaxation: residual {:.2e} after {} steps", r.residual, r.steps));
+        return Err(format!(
+            "relaxation: residual {:.2e} after {} steps",
+            r.residual, r.steps
+        ));
     }
     let tip = vec_u32(m, "tip_centre_nodes");
     let uz = tip.iter().map(|&n| r.sim.u[n as usize][2]).sum::<f64>() / tip.len() as f64;
@@ -62,7 +79,10 @@ pub fn run() -> CaseOutput {
     let mut series = Series {
         plot: "cantilever_locking".into(),
         title: "Cantilever: tip deflection / Timoshenko".into(),
-        axes: ("elements along the length".into(), "u_tip / u_Timoshenko".into()),
+        axes: (
+            "elements along the length".into(),
+            "u_tip / u_Timoshenko".into(),
+        ),
         log: false,
         curves: Vec::new(),
     };
@@ -71,7 +91,12 @@ pub fn run() -> CaseOutput {
         "scikit-fem Q1".into(),
         meshes
             .iter()
-            .map(|m| (vec_u32(m, "divisions")[0] as f64, f(m, "solution.tip_uz_centre") / timo))
+            .map(|m| {
+                (
+                    vec_u32(m, "divisions")[0] as f64,
+                    f(m, "solution.tip_uz_centre") / timo,
+                )
+            })
             .collect(),
     ));
     for form in [FULL, FULL_FBAR, ONE_POINT_STIFFNESS] {
@@ -93,7 +118,15 @@ pub fn run() -> CaseOutput {
                             Some(Q1_TOLERANCE),
                         ));
                     }
-                    out.rows.push(Row::compare(&case, "tip u_z (m)", "Timoshenko beam", timo, uz, timo, None));
+                    out.rows.push(Row::compare(
+                        &case,
+                        "tip u_z (m)",
+                        "Timoshenko beam",
+                        timo,
+                        uz,
+                        timo,
+                        None,
+                    ));
                     out.notes.push(format!(
                         "{case}: tip {uz:.5e} m = {:.3} x Timoshenko ({steps} relaxation steps)",
                         uz / timo

@@ -83,12 +83,19 @@ pub fn laws() -> CaseOutput {
          [[segment]]\nramp_to = 1.6\nduration = 1\nsteps = 110\n",
         ogden_card()
     );
-    let uni = |l: f64| (0..3).map(|p| MU[p] * (l.powf(ALPHA[p] - 1.0) - l.powf(-ALPHA[p] / 2.0 - 1.0))).sum();
+    let uni = |l: f64| {
+        (0..3)
+            .map(|p| MU[p] * (l.powf(ALPHA[p] - 1.0) - l.powf(-ALPHA[p] / 2.0 - 1.0)))
+            .sum()
+    };
     let case = "Ogden uniaxial (liver constants, l 0.5-1.6)";
     let src = "closed form, incompressible Ogden";
     let q = "nominal stress P (Pa) at worst stretch; error = max rel. over path";
     match driver_error(&text, uni) {
-        Ok((e, want, got)) => out.rows.push(Row::with_error(case, q, src, want, got, e, Some(1e-3))),
+        Ok((e, want, got)) => {
+            out.rows
+                .push(Row::with_error(case, q, src, want, got, e, Some(1e-3)))
+        }
         Err(e) => out.rows.push(Row::failed(case, q, e)),
     }
     // Ogden equibiaxial.
@@ -97,10 +104,17 @@ pub fn laws() -> CaseOutput {
          [[segment]]\nramp_to = 1.3\nduration = 1\nsteps = 100\n",
         ogden_card()
     );
-    let bi = |l: f64| (0..3).map(|p| MU[p] * (l.powf(ALPHA[p] - 1.0) - l.powf(-2.0 * ALPHA[p] - 1.0))).sum();
+    let bi = |l: f64| {
+        (0..3)
+            .map(|p| MU[p] * (l.powf(ALPHA[p] - 1.0) - l.powf(-2.0 * ALPHA[p] - 1.0)))
+            .sum()
+    };
     let case = "Ogden equibiaxial (liver constants, l 0.8-1.3)";
     match driver_error(&text, bi) {
-        Ok((e, want, got)) => out.rows.push(Row::with_error(case, q, src, want, got, e, Some(1e-3))),
+        Ok((e, want, got)) => {
+            out.rows
+                .push(Row::with_error(case, q, src, want, got, e, Some(1e-3)))
+        }
         Err(e) => out.rows.push(Row::failed(case, q, e)),
     }
     // Prony step relaxation.
@@ -119,13 +133,26 @@ pub fn laws() -> CaseOutput {
             let mut worst: f64 = 0.0;
             let mut at = (f64::NAN, f64::NAN);
             for (t, s) in t.iter().zip(&sxy).skip(1) {
-                let want = gamma * (mu0 + prony.iter().map(|(g, tau)| g * (-t / tau).exp()).sum::<f64>());
+                let want = gamma
+                    * (mu0
+                        + prony
+                            .iter()
+                            .map(|(g, tau)| g * (-t / tau).exp())
+                            .sum::<f64>());
                 worst = worst.max((s - want).abs() / want.abs());
                 if (t - 0.1).abs() < 1e-9 {
                     at = (want, *s);
                 }
             }
-            out.rows.push(Row::with_error(case, q, "closed form, linear viscoelasticity", at.0, at.1, worst, Some(1e-5)));
+            out.rows.push(Row::with_error(
+                case,
+                q,
+                "closed form, linear viscoelasticity",
+                at.0,
+                at.1,
+                worst,
+                Some(1e-5),
+            ));
         }
         Err(e) => out.rows.push(Row::failed(case, q, e)),
     }
@@ -137,7 +164,12 @@ pub fn laws() -> CaseOutput {
     let q = "Kirchhoff stress tau_xx (Pa) at l = 1.1; error = max |dtau| / sigma_y";
     match run_driver_str(text, None) {
         Ok(o) => {
-            let (l, sx, ly, lz) = (col(&o, "stretch"), col(&o, "sigma_xx"), col(&o, "stretch_y"), col(&o, "stretch_z"));
+            let (l, sx, ly, lz) = (
+                col(&o, "stretch"),
+                col(&o, "sigma_xx"),
+                col(&o, "stretch_y"),
+                col(&o, "stretch_z"),
+            );
             let e1 = 1.1f64.ln();
             let mut worst: f64 = 0.0;
             let mut peak = (f64::NAN, f64::NAN);
@@ -150,7 +182,15 @@ pub fn laws() -> CaseOutput {
                     peak = (tau, tau_m);
                 }
             }
-            out.rows.push(Row::with_error(case, q, "closed form, bilinear in log strain", peak.0, peak.1, worst, Some(1e-6)));
+            out.rows.push(Row::with_error(
+                case,
+                q,
+                "closed form, bilinear in log strain",
+                peak.0,
+                peak.1,
+                worst,
+                Some(1e-6),
+            ));
         }
         Err(e) => out.rows.push(Row::failed(case, q, e)),
     }
@@ -177,7 +217,12 @@ pub fn bilinear(e: f64, leg: usize, e1: f64) -> f64 {
 
 fn elastic(e: f64, nu: f64, rho: f64) -> Material {
     let (lambda, mu) = material::law::lame(e, nu);
-    Material::LinearElastic(LinearElastic { rho, lambda, mu, kinematics: Kinematics::Green })
+    Material::LinearElastic(LinearElastic {
+        rho,
+        lambda,
+        mu,
+        kinematics: Kinematics::Green,
+    })
 }
 
 /// Arrival time of the wave front at the far end of a struck bar, and L/c.
@@ -185,31 +230,58 @@ pub fn wave_arrival() -> Result<(f64, f64), String> {
     let (e, nu, rho, l, v0) = (1e6, 0.3, 1000.0, 0.1, 0.05);
     let n = 400;
     let h = l / n as f64;
-    let mesh = box_mesh(&BoxSpec { size: [h, h, l], divisions: [1, 1, n], ..Default::default() }, "bar")?;
+    let mesh = box_mesh(
+        &BoxSpec {
+            size: [h, h, l],
+            divisions: [1, 1, n],
+            ..Default::default()
+        },
+        "bar",
+    )?;
     let ns = mesh.node_sets.clone();
     let model = Model::build(
         mesh,
-        vec![Part { name: "bar".into(), material: elastic(e, nu, rho), formulation: ONE_POINT_VISCOUS }],
+        vec![Part {
+            name: "bar".into(),
+            material: elastic(e, nu, rho),
+            formulation: ONE_POINT_VISCOUS,
+        }],
         None,
         0.9,
     )
     .map_err(|e| e.to_string())?;
     let mut c = vec![
-        Constraint { nodes: ns["zmin"].clone(), dof: 2, kind: Kinematic::Velocity(Curve::Constant(v0)) },
-        Constraint { nodes: ns["zmax"].clone(), dof: 2, kind: Kinematic::Fixed },
+        Constraint {
+            nodes: ns["zmin"].clone(),
+            dof: 2,
+            kind: Kinematic::Velocity(Curve::Constant(v0)),
+        },
+        Constraint {
+            nodes: ns["zmax"].clone(),
+            dof: 2,
+            kind: Kinematic::Fixed,
+        },
     ];
     for (s, d) in [("xmin", 0), ("xmax", 0), ("ymin", 1), ("ymax", 1)] {
-        c.push(Constraint { nodes: ns[s].clone(), dof: d, kind: Kinematic::Fixed });
+        c.push(Constraint {
+            nodes: ns[s].clone(),
+            dof: d,
+            kind: Kinematic::Fixed,
+        });
     }
     let far = ns["zmax"].clone();
-    let mut sim = Simulation::new(model, LoopSettings::default(), c, Vec::new(), None, false).map_err(|e| e.to_string())?;
+    let mut sim = Simulation::new(model, LoopSettings::default(), c, Vec::new(), None, false)
+        .map_err(|e| e.to_string())?;
     let (lambda, mu) = material::law::lame(e, nu);
     let cw = ((lambda + 2.0 * mu) / rho).sqrt();
     let half = rho * cw * v0 * h * h;
     let mut prev = (0.0, 0.0);
     while sim.time < 1.5 * l / cw {
         sim.step(f64::INFINITY).map_err(|e| e.to_string())?;
-        let r: f64 = -far.iter().map(|&k| sim.reaction[k as usize][2]).sum::<f64>();
+        let r: f64 = -far
+            .iter()
+            .map(|&k| sim.reaction[k as usize][2])
+            .sum::<f64>();
         if r >= half {
             let (t0, r0) = prev;
             return Ok((t0 + (half - r0) / (r - r0) * (sim.time - t0), l / cw));
@@ -225,33 +297,73 @@ pub fn wave() -> CaseOutput {
     let case = "1-D wave, bar struck at one end (400 elements)";
     let q = "front arrival time at far end (s)";
     match wave_arrival() {
-        Ok((t, tc)) => out.rows.push(Row::compare(case, q, "L / c, c = sqrt((lambda+2mu)/rho)", tc, t, tc, Some(0.02))),
+        Ok((t, tc)) => out.rows.push(Row::compare(
+            case,
+            q,
+            "L / c, c = sqrt((lambda+2mu)/rho)",
+            tc,
+            t,
+            tc,
+            Some(0.02),
+        )),
         Err(e) => out.rows.push(Row::failed(case, q, e)),
     }
     out
 }
 
 /// First period of the cantilever (s), beam theory (s), largest energy error, and the tip history.
-pub fn cantilever_period(form: Formulation, div: [usize; 3]) -> Result<(f64, f64, f64, Vec<(f64, f64)>), String> {
+pub fn cantilever_period(
+    form: Formulation,
+    div: [usize; 3],
+) -> Result<(f64, f64, f64, Vec<(f64, f64)>), String> {
     let (e, rho, l, h) = (1e6, 1000.0, 0.1, 0.01);
-    let mesh = box_mesh(&BoxSpec { size: [l, h, h], divisions: div, ..Default::default() }, "beam")?;
+    let mesh = box_mesh(
+        &BoxSpec {
+            size: [l, h, h],
+            divisions: div,
+            ..Default::default()
+        },
+        "beam",
+    )?;
     let clamp = mesh.node_sets["xmin"].clone();
     let bl: f64 = 1.875_104_068_711_961;
     let s = (bl.cosh() + bl.cos()) / (bl.sinh() + bl.sin());
     let b = bl / l;
     let phi = |x: f64| (b * x).cosh() - (b * x).cos() - s * ((b * x).sinh() - (b * x).sin());
     let v0 = 1e-3;
-    let vel: Vec<[f64; 3]> = mesh.nodes.iter().map(|p| [0.0, 0.0, v0 * phi(p[0]) / phi(l)]).collect();
+    let vel: Vec<[f64; 3]> = mesh
+        .nodes
+        .iter()
+        .map(|p| [0.0, 0.0, v0 * phi(p[0]) / phi(l)])
+        .collect();
     let tip = mesh.node_sets["xmax"].clone();
     let model = Model::build(
         mesh,
-        vec![Part { name: "beam".into(), material: elastic(e, 0.0, rho), formulation: form }],
+        vec![Part {
+            name: "beam".into(),
+            material: elastic(e, 0.0, rho),
+            formulation: form,
+        }],
         None,
         0.9,
     )
     .map_err(|e| e.to_string())?;
-    let c = (0..3).map(|d| Constraint { nodes: clamp.clone(), dof: d, kind: Kinematic::Fixed }).collect();
-    let mut sim = Simulation::new(model, LoopSettings::default(), c, Vec::new(), Some(vel), false).map_err(|e| e.to_string())?;
+    let c = (0..3)
+        .map(|d| Constraint {
+            nodes: clamp.clone(),
+            dof: d,
+            kind: Kinematic::Fixed,
+        })
+        .collect();
+    let mut sim = Simulation::new(
+        model,
+        LoopSettings::default(),
+        c,
+        Vec::new(),
+        Some(vel),
+        false,
+    )
+    .map_err(|e| e.to_string())?;
     let t_eb = 2.0 * std::f64::consts::PI / (bl * bl * (e * h * h / 12.0 / rho / l.powi(4)).sqrt());
     let mut crossings = Vec::new();
     let mut prev = (0.0, 0.0);
@@ -272,7 +384,9 @@ pub fn cantilever_period(form: Formulation, div: [usize; 3]) -> Result<(f64, f64
         }
     }
     if crossings.len() < 2 {
-        return Err(format!("too few zero crossings of the tip within 2.5 T: {crossings:?}"));
+        return Err(format!(
+            "too few zero crossings of the tip within 2.5 T: {crossings:?}"
+        ));
     }
     Ok((2.0 * (crossings[1] - crossings[0]), t_eb, max_err, trace))
 }
@@ -295,12 +409,37 @@ pub fn vibration() -> CaseOutput {
         (ONE_POINT_STIFFNESS, [10, 1, 1], None),
         (FULL, [10, 1, 1], None),
     ] {
-        let case = format!("free vibration {}x{}x{}, {}", div[0], div[1], div[2], short(&form));
+        let case = format!(
+            "free vibration {}x{}x{}, {}",
+            div[0],
+            div[1],
+            div[2],
+            short(&form)
+        );
         match cantilever_period(form, div) {
             Ok((t, t_eb, err, trace)) => {
-                out.rows.push(Row::compare(&case, "first period (s)", src, t_eb, t, t_eb, tol));
-                out.rows.push(Row::with_error(&case, "max energy error (fraction)", "energy balance", 0.0, err, err, tol.map(|_| 0.01)));
-                series.curves.push((case.trim_start_matches("free vibration ").to_string(), trace));
+                out.rows.push(Row::compare(
+                    &case,
+                    "first period (s)",
+                    src,
+                    t_eb,
+                    t,
+                    t_eb,
+                    tol,
+                ));
+                out.rows.push(Row::with_error(
+                    &case,
+                    "max energy error (fraction)",
+                    "energy balance",
+                    0.0,
+                    err,
+                    err,
+                    tol.map(|_| 0.01),
+                ));
+                series.curves.push((
+                    case.trim_start_matches("free vibration ").to_string(),
+                    trace,
+                ));
             }
             Err(e) => out.rows.push(Row::failed(&case, "first period (s)", e)),
         }
@@ -315,13 +454,33 @@ pub fn hertz() -> CaseOutput {
     let case = "Hertz contact, rigid sphere R 5 mm, d 0.5 mm";
     let q = "indenter force F_z (N), quarter model";
     match crate::hard::run_contact_scene(HERTZ_SCENE, "hertz", "sphere") {
-        Err(e) if e.contains("not implemented") => out.rows.push(Row::not_yet(case, q, format!("the solver's contact stage is not integrated yet ({e})"))),
+        Err(e) if e.contains("not implemented") => out.rows.push(Row::not_yet(
+            case,
+            q,
+            format!("the solver's contact stage is not integrated yet ({e})"),
+        )),
         Err(e) => out.rows.push(Row::failed(case, q, e)),
         Ok(r) => {
             let (e, nu, radius, d) = (30e3f64, 0.49f64, 5e-3f64, 0.5e-3f64);
             let f = 4.0 / 3.0 * e / (1.0 - nu * nu) * radius.sqrt() * d.powf(1.5) / 4.0;
-            out.rows.push(Row::compare(case, q, "Hertz 4/3 E* sqrt(R) d^1.5 / 4", f, r.force, f, Some(0.05)));
-            out.rows.push(Row::with_error(case, "max energy error (fraction)", "energy balance", 0.0, r.energy_error, r.energy_error, Some(0.01)));
+            out.rows.push(Row::compare(
+                case,
+                q,
+                "Hertz 4/3 E* sqrt(R) d^1.5 / 4",
+                f,
+                r.force,
+                f,
+                Some(0.05),
+            ));
+            out.rows.push(Row::with_error(
+                case,
+                "max energy error (fraction)",
+                "energy balance",
+                0.0,
+                r.energy_error,
+                r.energy_error,
+                Some(0.01),
+            ));
         }
     }
     out

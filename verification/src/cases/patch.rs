@@ -85,7 +85,10 @@ pub fn patch_errors(reference: &str, form: Formulation) -> Result<PatchResult, S
 /// All patch-test rows.
 pub fn run() -> CaseOutput {
     let mut out = CaseOutput::default();
-    for (reference, text) in [("scikit-fem", data::PATCH_SKFEM), ("FEniCSx", data::PATCH_FENICSX)] {
+    for (reference, text) in [
+        ("scikit-fem", data::PATCH_SKFEM),
+        ("FEniCSx", data::PATCH_FENICSX),
+    ] {
         for form in [ONE_POINT_VISCOUS, ONE_POINT_STIFFNESS, FULL_FBAR, FULL] {
             let case = format!("patch test, {}", short(&form));
             let src = format!("{reference} Q1 (distorted 3x3x3)");
@@ -109,7 +112,10 @@ pub fn run() -> CaseOutput {
                         p.r_error,
                         Some(TOLERANCE),
                     ));
-                    out.notes.push(format!("{case} vs {reference}: {} relaxation steps", p.steps));
+                    out.notes.push(format!(
+                        "{case} vs {reference}: {} relaxation steps",
+                        p.steps
+                    ));
                 }
                 Err(e) => out.rows.push(Row::failed(&case, "nodal displacements", e)),
             }
