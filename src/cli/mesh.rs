@@ -153,24 +153,13 @@ pub struct ImageArgs {
     common: CommonArgs,
 }
 
-/// Parse a length: `3mm`, `"3 mm"`, `0.3 cm`; a plain number is metres.
+/// Parse a length: `3mm`, `"3 mm"`, `0.3 cm`; a plain number is metres ([`super::units`]).
 fn length(s: &str) -> Result<f64, String> {
-    let v = Quantity::parse(s)?.get(Dim::LENGTH)?;
-    if !v.is_finite() {
-        return Err(format!("`{s}` is not a finite length"));
-    }
-    Ok(v)
+    super::units::length(s, "length")
 }
 
 fn lengths(s: &str, n: usize) -> Result<Vec<f64>, String> {
-    let parts: Vec<&str> = s.split(',').collect();
-    if parts.len() != n {
-        return Err(format!(
-            "`{s}`: expected {n} comma-separated lengths, got {}",
-            parts.len()
-        ));
-    }
-    parts.iter().map(|p| length(p)).collect()
+    super::units::lengths(s, n, "lengths")
 }
 
 fn point3(s: &str) -> Result<[f64; 3], String> {

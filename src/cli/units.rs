@@ -5,9 +5,13 @@ use material::quantity::{Dim, Quantity};
 
 /// Parse `s` as a quantity of dimension `dim` (SI value); `flag` names the option in errors.
 pub fn quantity(s: &str, dim: Dim, flag: &str) -> Result<f64, String> {
-    Quantity::parse(s)
+    let v = Quantity::parse(s)
         .and_then(|q| q.get(dim))
-        .map_err(|e| format!("{flag}: {e}"))
+        .map_err(|e| format!("{flag}: {e}"))?;
+    if !v.is_finite() {
+        return Err(format!("{flag}: `{s}` is not finite"));
+    }
+    Ok(v)
 }
 
 /// A length in m.
