@@ -314,6 +314,10 @@ impl Law for Foam {
         (m * damping_factor(self.damping * self.shear / m) / self.rho).sqrt()
     }
 
+    fn initial_shear_modulus(&self) -> f64 {
+        self.f_and_slope(0.0).1 / 2.0
+    }
+
     #[inline]
     fn evaluate(&self, f: &Mat3, _dt: f64, history: &mut [f64]) -> Result<Response, LawError> {
         checked_jacobian(f)?;

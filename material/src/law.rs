@@ -59,6 +59,9 @@ pub trait Law: Sync + Send {
     }
     /// Dilatational wave speed of the undeformed material (m/s).
     fn initial_wave_speed(&self) -> f64;
+    /// Instantaneous small-strain shear modulus of the undeformed material (Pa): the modulus
+    /// that resists isochoric deformation, which shear-scaled hourglass control uses.
+    fn initial_shear_modulus(&self) -> f64;
     /// Evaluate the stress at deformation gradient `f` at the end of a step of length `dt` (s).
     fn evaluate(&self, f: &Mat3, dt: f64, history: &mut [f64]) -> Result<Response, LawError>;
 }

@@ -61,6 +61,10 @@ impl Material {
     pub fn initial_wave_speed(&self) -> f64 {
         with_law!(self, l => l.initial_wave_speed())
     }
+    /// Instantaneous small-strain shear modulus (Pa).
+    pub fn initial_shear_modulus(&self) -> f64 {
+        with_law!(self, l => l.initial_shear_modulus())
+    }
     /// History values per integration point.
     pub fn history_len(&self) -> usize {
         with_law!(self, l => l.history_len())

@@ -29,6 +29,9 @@ impl Law for NeoHookean {
     fn initial_wave_speed(&self) -> f64 {
         ((self.lambda + 2.0 * self.mu) / self.rho).sqrt()
     }
+    fn initial_shear_modulus(&self) -> f64 {
+        self.mu
+    }
     #[inline]
     fn evaluate(&self, f: &Mat3, _dt: f64, _h: &mut [f64]) -> Result<Response, LawError> {
         let j = checked_jacobian(f)?;

@@ -215,6 +215,20 @@ impl Ogden {
         &self.prony[..self.np]
     }
 
+    /// Elastic small-strain shear modulus mu0 = 1/2 sum |mu_p alpha_p| and the summed Prony
+    /// moduli.
+    fn initial_shear_parts(&self) -> (f64, f64) {
+        let g: f64 = self.prony().iter().map(|t| t.modulus).sum();
+        let mu_eff: f64 = 0.5
+            * self
+                .mu()
+                .iter()
+                .zip(self.alpha())
+                .map(|(m, a)| (m * a).abs())
+                .sum::<f64>();
+        (mu_eff, g)
+    }
+
     fn visc_modulus_factor(&self) -> f64 {
         match self.prony_on {
             PronyOn::GreenLagrange => 2.0,
@@ -279,15 +293,15 @@ impl Law for Ogden {
         v
     }
     fn initial_wave_speed(&self) -> f64 {
-        let g: f64 = self.prony().iter().map(|t| t.modulus).sum();
-        let mu_eff: f64 = 0.5
-            * self
-                .mu()
-                .iter()
-                .zip(self.alpha())
-                .map(|(m, a)| (m * a).abs())
-                .sum::<f64>();
+        let (mu_eff, g) = self.initial_shear_parts();
         ((self.bulk + 4.0 / 3.0 * mu_eff + self.visc_modulus_factor() * g) / self.rho).sqrt()
+    }
+
+    fn initial_shear_modulus(&self) -> f64 {
+        // The Prony term adds visc_modulus_factor * g to the P-wave modulus, i.e. 3/4 of that
+        // to the shear modulus.
+        let (mu_eff, g) = self.initial_shear_parts();
+        mu_eff + 0.75 * self.visc_modulus_factor() * g
     }
 
     #[inline]

@@ -205,6 +205,10 @@ impl Law for Plasticity {
         ((self.bulk + 4.0 / 3.0 * self.shear) / self.rho).sqrt()
     }
 
+    fn initial_shear_modulus(&self) -> f64 {
+        self.shear
+    }
+
     #[inline]
     fn evaluate(&self, f: &Mat3, _dt: f64, history: &mut [f64]) -> Result<Response, LawError> {
         checked_jacobian(f)?;

@@ -26,6 +26,10 @@ pub struct ElementTotals {
     pub bulk_power: f64,
     /// Law dissipation this step (J).
     pub law_dissipation: f64,
+    /// Elements that reached their failure criterion this step and are eroded from the next.
+    pub newly_eroded: u32,
+    /// The first of them (global id).
+    pub first_eroded: Option<u32>,
 }
 
 /// A raw pointer shared by the element loop to write disjoint per-element ranges.
@@ -69,6 +73,7 @@ pub fn element_loop(
         let hist = Shared(g.history.as_mut_ptr());
         let gslots = &mut slots[g.slot_offset..g.slot_offset + n];
         let (elements, conn, grad, vol0) = (&g.elements, &g.conn, &g.grad, &g.vol0);
+        let eroded = &g.eroded;
         let (gamma, hgk, gpg, gpw, dscale) = (
             &g.gamma,
             &g.hg_scale,
@@ -81,6 +86,10 @@ pub fn element_loop(
                 let mut acc = ChunkOut { dt_min: f64::INFINITY, ..Default::default() };
                 for (k, fe) in fch.iter_mut().enumerate() {
                     let le = ci * CHUNK + k;
+                    if !eroded.is_empty() && eroded[le] {
+                        *fe = [[0.0; 8]; 3];
+                        continue;
+                    }
                     let c = &conn[le];
                     let mut xe: Nodal = [[0.0; 8]; 3];
                     let mut ue: Nodal = [[0.0; 8]; 3];
@@ -127,8 +136,8 @@ pub fn element_loop(
                             acc.hg_power += o.hourglass_power;
                             acc.bulk_power += o.bulk_power;
                             acc.law_dissipation += o.law_dissipation;
-                            if o.failed && acc.failed.is_none() {
-                                acc.failed = Some(elements[le]);
+                            if o.failed {
+                                acc.failed.push(le as u32);
                             }
                             if let Some(sp) = stress_ptr {
                                 // SAFETY: one element writes one entry.
@@ -146,9 +155,22 @@ pub fn element_loop(
                 *out = acc;
             });
         });
-        for ch in &g.chunks {
+        for ch in g.chunks.iter_mut() {
             if let Some(e) = &ch.error {
                 return Err(e.clone());
+            }
+            // Erosion (LS-DYNA element deletion): a failed element keeps its nodal mass and
+            // carries no force from the next step on. The eroded array exists only once an
+            // element of the group has failed.
+            for &le in &ch.failed {
+                if g.eroded.is_empty() {
+                    g.eroded = vec![false; n];
+                }
+                if !g.eroded[le as usize] {
+                    g.eroded[le as usize] = true;
+                    tot.newly_eroded += 1;
+                    tot.first_eroded.get_or_insert(g.elements[le as usize]);
+                }
             }
             if ch.dt_min < tot.dt_min {
                 tot.dt_min = ch.dt_min;

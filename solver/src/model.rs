@@ -15,7 +15,7 @@
 //! The added mass is reported per part.
 
 use crate::element::max_face_area;
-use crate::element::{Formulation, HourglassForm};
+use crate::element::{Formulation, HourglassForm, HourglassModulus};
 use crate::hex::{element_geometry, hourglass_gamma};
 use crate::mesh::Mesh;
 use material::Material;
@@ -114,8 +114,8 @@ pub struct ChunkOut {
     pub law_dissipation: f64,
     /// First error: (global element, message).
     pub error: Option<(u32, String)>,
-    /// First failed element.
-    pub failed: Option<u32>,
+    /// Elements (group-local index) that reached their law's failure criterion this step.
+    pub failed: Vec<u32>,
 }
 
 /// A group of elements with one law and one formulation (struct of arrays).
@@ -281,6 +281,7 @@ impl Model {
             };
             let mut scale = Vec::with_capacity(n);
             let lambda2mu = rho * c0 * c0;
+            let two_mu = 2.0 * law.initial_shear_modulus();
             for &e in &elems {
                 let conn = mesh.elements[e as usize];
                 let x: [[f64; 3]; 8] = std::array::from_fn(|a| mesh.nodes[conn[a] as usize]);
@@ -305,11 +306,22 @@ impl Model {
                                     bb += b * b;
                                 }
                             }
+                            let modulus = match hg.modulus {
+                                HourglassModulus::PWave => lambda2mu,
+                                HourglassModulus::Shear => two_mu,
+                            };
                             g.hg_scale
-                                .push(hg.coefficient * lambda2mu * bb / (3.0 * geo.volume) / 64.0);
+                                .push(hg.coefficient * modulus * bb / (3.0 * geo.volume) / 64.0);
                         } else {
-                            g.hg_scale
-                                .push(hg.coefficient * rho * geo.volume.powf(2.0 / 3.0) * 0.25);
+                            // The kernel multiplies by the current wave speed c; the shear
+                            // form scales c by sqrt(2 mu0 / (rho c0^2)).
+                            let ratio = match hg.modulus {
+                                HourglassModulus::PWave => 1.0,
+                                HourglassModulus::Shear => (two_mu / lambda2mu).sqrt(),
+                            };
+                            g.hg_scale.push(
+                                hg.coefficient * rho * geo.volume.powf(2.0 / 3.0) * 0.25 * ratio,
+                            );
                         }
                     }
                     Formulation::Full { .. } => {

@@ -31,15 +31,30 @@ pub enum Place {
 /// Element formulation of every part.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum ElementChoice {
-    /// One-point integration with viscous hourglass control (the default, as LS-DYNA's type 1).
+    /// One-point integration with viscous hourglass control scaled by the P-wave modulus
+    /// (LS-DYNA's type 1).
     OnePointViscous,
-    /// One-point integration with stiffness hourglass control.
+    /// One-point integration with stiffness hourglass control scaled by the P-wave modulus
+    /// (Flanagan-Belytschko, LS-DYNA type 4).
     OnePointStiffness,
+    /// One-point integration with viscous hourglass control scaled by the shear modulus.
+    OnePointViscousShear,
+    /// One-point integration with stiffness hourglass control scaled by the shear modulus
+    /// (in the spirit of LS-DYNA type 6).
+    OnePointStiffnessShear,
     /// Fully integrated 2x2x2 with F-bar.
     FullFbar,
 }
 
 impl ElementChoice {
+    /// Every choice, in table order.
+    pub const ALL: [ElementChoice; 5] = [
+        ElementChoice::OnePointViscous,
+        ElementChoice::OnePointStiffness,
+        ElementChoice::OnePointViscousShear,
+        ElementChoice::OnePointStiffnessShear,
+        ElementChoice::FullFbar,
+    ];
     /// Scene keys of the choice.
     fn scene_keys(&self) -> &'static str {
         match self {
@@ -49,6 +64,12 @@ impl ElementChoice {
             ElementChoice::OnePointStiffness => {
                 "formulation = \"one_point\", hourglass = \"stiffness\""
             }
+            ElementChoice::OnePointViscousShear => {
+                "formulation = \"one_point\", hourglass = \"viscous\", hourglass_modulus = \"shear\""
+            }
+            ElementChoice::OnePointStiffnessShear => {
+                "formulation = \"one_point\", hourglass = \"stiffness\", hourglass_modulus = \"shear\""
+            }
             ElementChoice::FullFbar => "formulation = \"full_fbar\"",
         }
     }
@@ -57,6 +78,8 @@ impl ElementChoice {
         match self {
             ElementChoice::OnePointViscous => "1pt-viscous",
             ElementChoice::OnePointStiffness => "1pt-stiffness",
+            ElementChoice::OnePointViscousShear => "1pt-viscous-shear",
+            ElementChoice::OnePointStiffnessShear => "1pt-stiffness-shear",
             ElementChoice::FullFbar => "full-fbar",
         }
     }
@@ -66,11 +89,16 @@ impl std::str::FromStr for ElementChoice {
     type Err = String;
     fn from_str(s: &str) -> Result<Self, String> {
         match s {
-            "one_point" | "1pt-viscous" | "viscous" => Ok(ElementChoice::OnePointViscous),
+            "1pt-viscous" | "viscous" => Ok(ElementChoice::OnePointViscous),
             "1pt-stiffness" | "stiffness" => Ok(ElementChoice::OnePointStiffness),
+            "1pt-viscous-shear" | "viscous-shear" => Ok(ElementChoice::OnePointViscousShear),
+            "one_point" | "1pt-stiffness-shear" | "stiffness-shear" => {
+                Ok(ElementChoice::OnePointStiffnessShear)
+            }
             "full_fbar" | "full-fbar" | "full" => Ok(ElementChoice::FullFbar),
             o => Err(format!(
-                "unknown element formulation `{o}` (one_point, stiffness, full_fbar)"
+                "unknown element formulation `{o}` (1pt-viscous, 1pt-stiffness, \
+                 1pt-viscous-shear, 1pt-stiffness-shear, full_fbar)"
             )),
         }
     }

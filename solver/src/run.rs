@@ -82,6 +82,11 @@ pub struct RunSummary {
     pub threads: usize,
     /// Frames written.
     pub frames: usize,
+    /// Elements eroded by their law's failure criterion.
+    pub eroded_elements: u64,
+    /// The first eroded element: (element, part, time in s).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub first_eroded: Option<(u32, String, f64)>,
 }
 
 /// Progress information for a progress bar.
@@ -446,6 +451,8 @@ pub fn run_scene(
             .collect(),
         threads: rayon::current_num_threads(),
         frames: series.len(),
+        eroded_elements: sim.eroded.0,
+        first_eroded: sim.eroded.1.map(|(e, t)| (e, sim.part_of(e), t)),
     };
     if let Ok(js) = serde_json::to_string_pretty(&summary) {
         if let Err(e) =

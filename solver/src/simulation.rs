@@ -230,6 +230,8 @@ pub struct Simulation {
     pub residual: f64,
     /// Stage timers.
     pub timers: Vec<StageTime>,
+    /// Elements eroded so far, and the first one with its erosion time (s).
+    pub eroded: (u64, Option<(u32, f64)>),
     totals: ElementTotals,
     initialised: bool,
     hg_dissipated: f64,
@@ -355,6 +357,7 @@ impl Simulation {
             ke_half_prev: 0.0,
             residual: f64::INFINITY,
             timers,
+            eroded: (0, None),
             totals: ElementTotals::default(),
             initialised: false,
             hg_dissipated: 0.0,
@@ -449,8 +452,19 @@ impl Simulation {
             reason,
         })?;
         self.totals = tot;
-        self.dt_next = self.settings.dt_factor * tot.dt_min;
-        self.dt_element = tot.dt_elem;
+        if tot.newly_eroded > 0 {
+            self.eroded.0 += tot.newly_eroded as u64;
+            if self.eroded.1.is_none() {
+                self.eroded.1 = tot.first_eroded.map(|e| (e, self.time));
+            }
+        }
+        if tot.dt_min.is_infinite() && self.eroded.0 > 0 {
+            // Every element has eroded: the nodes fly free, keep the last step.
+            self.dt_next = self.dt_prev;
+        } else {
+            self.dt_next = self.settings.dt_factor * tot.dt_min;
+            self.dt_element = tot.dt_elem;
+        }
         self.time_stage(T_GATHER, |s| gather(&s.model, &s.slots, &mut s.f_int));
         Ok(())
     }

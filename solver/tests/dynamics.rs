@@ -196,6 +196,7 @@ fn cantilever_first_period_one_point_stiffness_hourglass() {
     let hg = Hourglass {
         form: solver::element::HourglassForm::Stiffness,
         coefficient: 0.1,
+        modulus: solver::element::HourglassModulus::PWave,
     };
     let (ratio, err) = cantilever_period(Formulation::OnePoint(hg), [40, 4, 4], 1.3);
     assert!(ratio > 1.0 && ratio < 1.05, "period ratio {ratio}");
@@ -229,6 +230,7 @@ fn cantilever_coarse_mesh_formulations_differ() {
     let hg = Hourglass {
         form: solver::element::HourglassForm::Stiffness,
         coefficient: 0.1,
+        modulus: solver::element::HourglassModulus::PWave,
     };
     let (r1, _) = cantilever_period(Formulation::OnePoint(hg), [10, 1, 1], 20.0);
     let (r2, _) = cantilever_period(Formulation::Full { fbar: false }, [10, 1, 1], 2.0);

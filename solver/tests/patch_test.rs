@@ -109,7 +109,8 @@ fn patch_test_one_point_stiffness() {
     assert!(
         patch(Formulation::OnePoint(Hourglass {
             form: HourglassForm::Stiffness,
-            coefficient: 0.1
+            coefficient: 0.1,
+            modulus: solver::element::HourglassModulus::PWave,
         })) < 1e-8
     );
 }

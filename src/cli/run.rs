@@ -46,6 +46,13 @@ pub fn print_summary(s: &RunSummary) {
             m.part, m.physical_kg, m.added_kg, m.added_percent
         );
     }
+    if let Some((e, part, t)) = &s.first_eroded {
+        println!(
+            "  eroded elements: {} (the first, element {e} of part `{part}`, at {:.4} ms)",
+            s.eroded_elements,
+            t * 1e3
+        );
+    }
 }
 
 /// Run a scene file.

@@ -47,6 +47,26 @@ pub enum HourglassForm {
     Stiffness,
 }
 
+/// Which modulus scales the hourglass resistance.
+///
+/// Flanagan and Belytschko (1981) scale both forms by the dilatational (P-wave) modulus
+/// `lambda + 2 mu` (the viscous form through `rho c`), as LS-DYNA types 1-5 do. For a nearly
+/// incompressible solid (soft tissue, K/G up to 5e4) that modulus is the bulk modulus, and the
+/// hourglass forces then resist the isochoric hourglass modes thousands of times more than the
+/// material itself does: the mesh locks and the viscous form dissipates much of the work.
+/// The hourglass modes are deviatoric, so Belytschko and Bindeman (1993, LS-DYNA type 6) and
+/// Puso (2000) scale them by the shear modulus instead. `Shear` replaces `lambda + 2 mu` by
+/// `2 mu` (the P-wave modulus of a solid with the same shear modulus and lambda = 0) in the
+/// stiffness form, and `c` by `c * sqrt(2 mu0 / (rho c0^2))` in the viscous form, so that the
+/// viscous coefficient follows the law's stretch stiffening like the P-wave form does.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum HourglassModulus {
+    /// `lambda + 2 mu` (LS-DYNA types 1-5, OpenRadioss Iset 1-3).
+    PWave,
+    /// `2 mu` (shear-scaled, in the spirit of LS-DYNA type 6).
+    Shear,
+}
+
 /// Hourglass control of a part.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Hourglass {
@@ -54,6 +74,8 @@ pub struct Hourglass {
     pub form: HourglassForm,
     /// Coefficient Q (LS-DYNA QH, default 0.1).
     pub coefficient: f64,
+    /// Modulus that scales the resistance.
+    pub modulus: HourglassModulus,
 }
 
 impl Default for Hourglass {
@@ -61,6 +83,7 @@ impl Default for Hourglass {
         Hourglass {
             form: HourglassForm::Viscous,
             coefficient: 0.1,
+            modulus: HourglassModulus::PWave,
         }
     }
 }
@@ -90,7 +113,12 @@ impl Formulation {
     pub fn label(&self) -> String {
         match self {
             Formulation::OnePoint(h) => format!(
-                "one-point, {} hourglass Q={}",
+                "one-point, {}{} hourglass Q={}",
+                if h.modulus == HourglassModulus::Shear {
+                    "shear-scaled "
+                } else {
+                    ""
+                },
                 if h.form == HourglassForm::Viscous {
                     "viscous"
                 } else {

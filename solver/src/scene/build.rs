@@ -4,7 +4,7 @@ use super::contact_spec::HandScene;
 use super::spec::*;
 use crate::bc::{Constraint, Kinematic, NodalLoad};
 use crate::curve::Curve;
-use crate::element::{BulkViscosity, Formulation, Hourglass, HourglassForm};
+use crate::element::{BulkViscosity, Formulation, Hourglass, HourglassForm, HourglassModulus};
 use crate::generate::{box_mesh, BoxSpec};
 use crate::mesh::Mesh;
 use crate::model::{MassScaling, Model, Part};
@@ -243,12 +243,24 @@ fn formulation(p: &PartSpec) -> Result<Formulation, String> {
             ))
         }
     };
+    let modulus = match p.hourglass_modulus.as_deref() {
+        None | Some("p_wave") => HourglassModulus::PWave,
+        Some("shear") => HourglassModulus::Shear,
+        Some(o) => {
+            return Err(format!(
+                "hourglass_modulus must be `p_wave` or `shear`, got `{o}`"
+            ))
+        }
+    };
     Ok(match p.formulation.as_deref() {
         None | Some("one_point") => Formulation::OnePoint(Hourglass {
             form,
             coefficient: q,
+            modulus,
         }),
-        Some("full_fbar") | Some("full") if p.hourglass.is_some() => {
+        Some("full_fbar") | Some("full")
+            if p.hourglass.is_some() || p.hourglass_modulus.is_some() =>
+        {
             return Err("hourglass control applies to one_point elements only".into())
         }
         Some("full_fbar") => Formulation::Full { fbar: true },

@@ -112,6 +112,9 @@ pub struct PartSpec {
     pub hourglass: Option<String>,
     /// Hourglass coefficient (default 0.1).
     pub hourglass_coefficient: Option<Number>,
+    /// Modulus scaling the hourglass control: `p_wave` (default, lambda + 2 mu as LS-DYNA
+    /// types 1-5) or `shear` (2 mu, for nearly incompressible tissue).
+    pub hourglass_modulus: Option<String>,
 }
 
 /// `[node_sets.NAME]`.

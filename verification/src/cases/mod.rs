@@ -5,17 +5,19 @@ pub mod cantilever;
 pub mod closed;
 pub mod patch;
 
-use solver::element::{Formulation, Hourglass, HourglassForm};
+use solver::element::{Formulation, Hourglass, HourglassForm, HourglassModulus};
 
 /// One-point integration, viscous hourglass control (LS-DYNA default, Q = 0.1).
 pub const ONE_POINT_VISCOUS: Formulation = Formulation::OnePoint(Hourglass {
     form: HourglassForm::Viscous,
     coefficient: 0.1,
+    modulus: HourglassModulus::PWave,
 });
 /// One-point integration, Flanagan-Belytschko stiffness hourglass control, Q = 0.1.
 pub const ONE_POINT_STIFFNESS: Formulation = Formulation::OnePoint(Hourglass {
     form: HourglassForm::Stiffness,
     coefficient: 0.1,
+    modulus: HourglassModulus::PWave,
 });
 /// Fully integrated 2x2x2 with F-bar.
 pub const FULL_FBAR: Formulation = Formulation::Full { fbar: true };
