@@ -90,9 +90,10 @@ impl std::str::FromStr for ElementChoice {
     fn from_str(s: &str) -> Result<Self, String> {
         match s {
             "1pt-viscous" | "viscous" => Ok(ElementChoice::OnePointViscous),
+            "one_point" => Ok(ElementChoice::OnePointViscousShear),
             "1pt-stiffness" | "stiffness" => Ok(ElementChoice::OnePointStiffness),
             "1pt-viscous-shear" | "viscous-shear" => Ok(ElementChoice::OnePointViscousShear),
-            "one_point" | "1pt-stiffness-shear" | "stiffness-shear" => {
+            "1pt-stiffness-shear" | "stiffness-shear" => {
                 Ok(ElementChoice::OnePointStiffnessShear)
             }
             "full_fbar" | "full-fbar" | "full" => Ok(ElementChoice::FullFbar),
@@ -170,7 +171,7 @@ impl Default for PalpationSetup {
             sample_interval: 0.005,
             finger_diameter: 0.015,
             finger_spacing: 0.020,
-            element: ElementChoice::OnePointViscous,
+            element: ElementChoice::OnePointViscousShear,
             mass_scaling_dt: None,
             mass_scaling_limit: 0.05,
             dt_factor: crate::simulation::DEFAULT_DT_FACTOR,

@@ -1,5 +1,6 @@
 //! Command-line parsing and dispatch.
 
+mod bench;
 mod campaign;
 mod check;
 mod evaluate;
@@ -102,6 +103,20 @@ enum Command {
     /// Leave-one-location-out cross-validation of each surrogate type and size, and the
     /// accuracy-versus-cost table (Fit, training time, prediction latency).
     Evaluate(evaluate::EvaluateArgs),
+    /// Whole-run throughput: element-cycles per second of 100k-element blocks (neo-Hookean
+    /// one-point and F-bar, and the two-finger press on the paper's flesh with the contact
+    /// stage's share), on each thread count, measured in one invocation.
+    Bench {
+        /// Cases: nh-1pt, nh-fbar, press.
+        #[arg(long, value_delimiter = ',', default_values_t = ["nh-1pt".to_string(), "nh-fbar".to_string(), "press".to_string()])]
+        cases: Vec<String>,
+        /// Thread counts to compare.
+        #[arg(long, value_delimiter = ',', default_values_t = [1usize, 2])]
+        threads: Vec<usize>,
+        /// Explicit steps per case.
+        #[arg(long, default_value_t = 100)]
+        steps: usize,
+    },
 }
 
 /// Set the global thread pool.
@@ -151,5 +166,10 @@ pub fn dispatch(cli: Cli) -> Result<(), String> {
         Command::Train(a) => train::train(&a),
         Command::Predict(a) => predict::predict(&a),
         Command::Evaluate(a) => evaluate::run(&a),
+        Command::Bench {
+            cases,
+            threads,
+            steps,
+        } => bench::bench(&cases, &threads, steps),
     }
 }

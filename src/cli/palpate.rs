@@ -53,8 +53,9 @@ pub struct PalpateArgs {
     /// Respiratory phase, 0 (exhalation) .. 1 (inspiration).
     #[arg(long, default_value_t = 0.0)]
     pub phase: f64,
-    /// Element formulation: one_point (viscous hourglass), stiffness (one-point, stiffness
-    /// hourglass) or full_fbar.
+    /// Element formulation: one_point (= 1pt-viscous-shear: one-point, viscous hourglass
+    /// control scaled by the shear modulus), 1pt-viscous or 1pt-stiffness (hourglass scaled by
+    /// the P-wave modulus, LS-DYNA types 1 and 4), 1pt-stiffness-shear, or full_fbar.
     #[arg(long, default_value = "one_point")]
     pub element: String,
     /// Selective mass scaling to this time step, e.g. `4us` (off by default).

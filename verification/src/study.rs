@@ -105,11 +105,7 @@ fn plan(quick: bool) -> (PalpationSetup, Vec<(String, String, PalpationSetup)>) 
             },
         ));
     }
-    for el in [
-        ElementChoice::OnePointViscous,
-        ElementChoice::OnePointStiffness,
-        ElementChoice::FullFbar,
-    ] {
+    for el in ElementChoice::ALL {
         v.push((
             "element".into(),
             el.label().into(),

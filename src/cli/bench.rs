@@ -1,0 +1,187 @@
+//! `palpa bench`: whole-run throughput of the explicit step, measured the way a user runs it.
+//!
+//! Every case is a real scene (built by the scene builder, with the stages that scene plans),
+//! stepped `--steps` times after its first force evaluation, inside a rayon pool of each
+//! requested thread count. Reported per case and thread count:
+//! - element-cycles per second = elements x steps / wall time of the stepping loop;
+//! - the share of step time of every active stage (elements, gather, update, contact, ...);
+//! - the speed-up of N threads over 1 thread, both measured in the same invocation.
+//!
+//! Cases (issue 2 and issue 4 of the tracker):
+//! - `nh-1pt`: a 100k-element (50 x 50 x 40) neo-Hookean block, one-point elements with viscous
+//!   hourglass control, fixed base and a top velocity load; floor 5 M element-cycles/s on
+//!   2 threads, aim 15 M;
+//! - `nh-fbar`: the same block with fully integrated F-bar elements;
+//! - `press`: the same block of the paper's flesh (simplified rubber/foam, K/G = 5e4, 2.8 mm
+//!   elements), pressed by the two-finger hand already in contact: the contact stage's share of
+//!   the step must stay at most 10 %.
+
+use solver::scene::build::build_scene;
+use solver::scene::SceneSpec;
+use std::path::Path;
+use std::time::Instant;
+
+/// The block shared by every case: 50 x 50 x 40 elements of 2.8 mm (the paper's voxel).
+const BLOCK: &str = r#"
+[mesh]
+generator = "box"
+origin = ["-70 mm", "-70 mm", "-112 mm"]
+size = ["140 mm", "140 mm", "112 mm"]
+divisions = [50, 50, 40]
+part = "body"
+
+[[boundary]]
+nodes = "zmin"
+fix = ["all"]
+
+[output]
+vtk = false
+"#;
+
+fn case_scene(case: &str) -> Result<String, String> {
+    let nh = r#"
+[materials.nh]
+law = "neo_hookean"
+density = "1000 kg/m^3"
+youngs_modulus = "1 MPa"
+poisson_ratio = 0.45
+"#;
+    let top_load = r#"
+[[boundary]]
+nodes = "zmax"
+velocity = { z = { kind = "constant", value = "-0.1 m/s" } }
+"#;
+    let body = match case {
+        "nh-1pt" => format!(
+            "{nh}{top_load}[[part]]\nname = \"body\"\nmaterial = \"nh\"\nformulation = \"one_point\"\nhourglass = \"viscous\"\n"
+        ),
+        "nh-fbar" => format!(
+            "{nh}{top_load}[[part]]\nname = \"body\"\nmaterial = \"nh\"\nformulation = \"full_fbar\"\n"
+        ),
+        "press" => r#"
+[[part]]
+name = "body"
+material = "paper:flesh"
+hourglass = "stiffness"
+hourglass_modulus = "shear"
+
+[[hand]]
+name = "hand"
+point = ["0 mm", "0 mm", "0 mm"]
+direction = [0, 0, -1]
+spacing_axis = [1, 0, 0]
+diameter = "15 mm"
+spacing = "20 mm"
+length = "60 mm"
+gap = "0 mm"
+motion = { kind = "velocity", curve = { kind = "constant", value = "0.6 m/s" } }
+
+[contact]
+surface = "zmax"
+"#
+        .to_string(),
+        o => return Err(format!("unknown bench case `{o}` (nh-1pt, nh-fbar, press)")),
+    };
+    Ok(format!(
+        "[run]\ntitle = \"bench {case}\"\nend_time = \"1 s\"\n{BLOCK}{body}"
+    ))
+}
+
+/// One measurement.
+struct Measured {
+    elements: usize,
+    seconds: f64,
+    stages: Vec<(&'static str, f64)>,
+}
+
+fn measure(case: &str, threads: usize, steps: usize) -> Result<Measured, String> {
+    let src = case_scene(case)?;
+    let spec: SceneSpec = toml::from_str(&src).map_err(|e| format!("bench scene {case}: {e}"))?;
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .map_err(|e| e.to_string())?;
+    pool.install(|| {
+        let mut scene = build_scene(spec, Path::new(&format!("bench-{case}.toml")), &src)?;
+        let sim = &mut scene.sim;
+        sim.initialise().map_err(|e| e.to_string())?;
+        for t in sim.timers.iter_mut() {
+            t.time = std::time::Duration::ZERO;
+        }
+        let t0 = Instant::now();
+        for _ in 0..steps {
+            sim.step(f64::INFINITY).map_err(|e| e.to_string())?;
+        }
+        let seconds = t0.elapsed().as_secs_f64();
+        let total: f64 = sim.timers.iter().map(|t| t.time.as_secs_f64()).sum();
+        Ok(Measured {
+            elements: sim.model.mesh.elements.len(),
+            seconds,
+            stages: sim
+                .timers
+                .iter()
+                .filter(|t| !t.time.is_zero())
+                .map(|t| (t.name, t.time.as_secs_f64() / total.max(1e-300)))
+                .collect(),
+        })
+    })
+}
+
+/// Run the benchmark cases and print the table.
+pub fn bench(cases: &[String], threads: &[usize], steps: usize) -> Result<(), String> {
+    if steps == 0 {
+        return Err("--steps must be at least 1".into());
+    }
+    if let Some(0) = threads.iter().find(|&&t| t == 0) {
+        return Err("--threads: every thread count must be at least 1".into());
+    }
+    println!(
+        "palpa bench: {steps} steps per case, element-cycles per second = elements x steps / wall time"
+    );
+    println!(
+        "{:<8} {:>7} {:>9} {:>9} {:>12} {:>8}  stage shares",
+        "case", "threads", "elements", "wall s", "M el-cyc/s", "speedup"
+    );
+    for case in cases {
+        let mut base = None;
+        for &t in threads {
+            let m = measure(case, t, steps)?;
+            let rate = (m.elements * steps) as f64 / m.seconds;
+            let speedup = match base {
+                None => {
+                    base = Some(rate);
+                    1.0
+                }
+                Some(b) => rate / b,
+            };
+            let shares: Vec<String> = m
+                .stages
+                .iter()
+                .map(|(n, s)| format!("{n} {:.1} %", 100.0 * s))
+                .collect();
+            println!(
+                "{case:<8} {t:>7} {:>9} {:>9.3} {:>12.3} {:>8.2}  {}",
+                m.elements,
+                m.seconds,
+                rate / 1e6,
+                speedup,
+                shares.join(", ")
+            );
+        }
+    }
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn every_case_scene_parses() {
+        for c in ["nh-1pt", "nh-fbar", "press"] {
+            let src = case_scene(c).unwrap();
+            let _: SceneSpec = toml::from_str(&src).unwrap();
+        }
+        assert!(case_scene("nope").is_err());
+    }
+}
