@@ -93,9 +93,7 @@ impl std::str::FromStr for ElementChoice {
             "one_point" => Ok(ElementChoice::OnePointViscousShear),
             "1pt-stiffness" | "stiffness" => Ok(ElementChoice::OnePointStiffness),
             "1pt-viscous-shear" | "viscous-shear" => Ok(ElementChoice::OnePointViscousShear),
-            "1pt-stiffness-shear" | "stiffness-shear" => {
-                Ok(ElementChoice::OnePointStiffnessShear)
-            }
+            "1pt-stiffness-shear" | "stiffness-shear" => Ok(ElementChoice::OnePointStiffnessShear),
             "full_fbar" | "full-fbar" | "full" => Ok(ElementChoice::FullFbar),
             o => Err(format!(
                 "unknown element formulation `{o}` (1pt-viscous, 1pt-stiffness, \

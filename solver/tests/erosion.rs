@@ -92,7 +92,14 @@ fn failed_element_is_eroded_and_the_bar_lets_go() {
         .collect();
     assert!(!after.is_empty());
     let worst = after.iter().cloned().fold(0.0, f64::max);
-    assert!(worst < 0.05 * peak, "reaction after erosion {worst} N (peak {peak} N)");
+    assert!(
+        worst < 0.05 * peak,
+        "reaction after erosion {worst} N (peak {peak} N)"
+    );
     assert!(err.iter().all(|e| e.is_finite()));
-    assert!(*err.last().unwrap() < 0.02, "energy error {}", err.last().unwrap());
+    assert!(
+        *err.last().unwrap() < 0.02,
+        "energy error {}",
+        err.last().unwrap()
+    );
 }
