@@ -14,7 +14,7 @@
 //! the liver's negative instantaneous Poisson ratio (with the Prony series on the deviatoric
 //! strain, K_inst = K = 32 kPa < 2/3 G_inst, nu_inst = (3K - 2G)/(2(3K + G)) < 0).
 
-use crate::cases::{short, FULL_FBAR, ONE_POINT_VISCOUS};
+use crate::cases::{short, FULL_FBAR, ONE_POINT_VISCOUS_SHEAR};
 use crate::{CaseOutput, Row, Status};
 use material::neo_hookean::NeoHookean;
 use material::Material;
@@ -228,7 +228,7 @@ pub fn liver_stretches() -> Result<HardRun, String> {
             Curve::Table(vec![(0.0, 0.0), (0.1, -0.5 * h), (0.2, 0.6 * h)]),
         ),
     ];
-    let mut s = sim(m, library("paper:liver"), ONE_POINT_VISCOUS, c)?;
+    let mut s = sim(m, library("paper:liver"), ONE_POINT_VISCOUS_SHEAR, c)?;
     Ok(run_explicit(&mut s, 0.2, |_| {}))
 }
 
@@ -251,7 +251,7 @@ pub fn patch_indentation(v: f64) -> Result<HardRun, String> {
         dof: 2,
         kind: Kinematic::Velocity(Curve::Table(vec![(0.0, 0.0), (t_ramp, -v), (t_end, -v)])),
     });
-    let mut s = sim(m, library("paper:flesh"), ONE_POINT_VISCOUS, c)?;
+    let mut s = sim(m, library("paper:flesh"), ONE_POINT_VISCOUS_SHEAR, c)?;
     Ok(run_explicit(&mut s, t_end, |_| {}))
 }
 
@@ -380,7 +380,7 @@ pub fn liver_negative_poisson_block() -> Result<(HardRun, f64), String> {
         .map_err(|e| e.to_string())?
         .build("liver")?;
     let xmax = ns["xmax"].clone();
-    let mut s = sim(m, mat, ONE_POINT_VISCOUS, c)?;
+    let mut s = sim(m, mat, ONE_POINT_VISCOUS_SHEAR, c)?;
     let r = run_explicit(&mut s, 0.003, |_| {});
     let ux = xmax.iter().map(|&n| s.u[n as usize][0]).sum::<f64>() / xmax.len() as f64;
     Ok((r, -(ux / h) / (-0.05)))
@@ -443,6 +443,7 @@ library = "paper:flesh"
 [[part]]
 name = "flesh"
 material = "flesh"
+hourglass_modulus = "shear"
 
 [[boundary]]
 nodes = "zmin"
@@ -466,7 +467,7 @@ fields = ["displacement"]
 /// The hard-case suite.
 pub fn run() -> CaseOutput {
     let mut out = CaseOutput::default();
-    for form in [ONE_POINT_VISCOUS, FULL_FBAR] {
+    for form in [ONE_POINT_VISCOUS_SHEAR, FULL_FBAR] {
         push_run(
             &mut out,
             &format!("flesh K/G 5e4, 30 % compression, {}", short(&form)),

@@ -19,6 +19,13 @@ pub const ONE_POINT_STIFFNESS: Formulation = Formulation::OnePoint(Hourglass {
     coefficient: 0.1,
     modulus: HourglassModulus::PWave,
 });
+/// One-point integration, viscous hourglass control scaled by the shear modulus (Q = 0.1): the
+/// choice for nearly incompressible tissue, and `palpa palpate`'s default.
+pub const ONE_POINT_VISCOUS_SHEAR: Formulation = Formulation::OnePoint(Hourglass {
+    form: HourglassForm::Viscous,
+    coefficient: 0.1,
+    modulus: HourglassModulus::Shear,
+});
 /// Fully integrated 2x2x2 with F-bar.
 pub const FULL_FBAR: Formulation = Formulation::Full { fbar: true };
 /// Fully integrated 2x2x2, plain (standard Q1).
