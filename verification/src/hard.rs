@@ -395,6 +395,10 @@ pub struct SceneRun {
     pub energy_error: f64,
     /// Hourglass / internal energy at the end.
     pub hourglass_ratio: f64,
+    /// Simulated time reached (s).
+    pub time: f64,
+    /// Steps taken.
+    pub steps: u64,
 }
 
 /// Write `scene` to a temporary directory, run it, and read the indenter `name`'s force.
@@ -419,6 +423,8 @@ pub fn run_contact_scene(scene: &str, tag: &str, name: &str) -> Result<SceneRun,
             energy_error: summary.max_energy_error,
             hourglass_ratio: summary.hourglass_energy.abs()
                 / summary.internal_energy.abs().max(1e-300),
+            time: summary.time,
+            steps: summary.steps,
         })
     })();
     let _ = std::fs::remove_dir_all(&dir);
@@ -538,6 +544,8 @@ pub fn run() -> CaseOutput {
             let hr = HardRun {
                 energy_error: r.energy_error,
                 hourglass_ratio: r.hourglass_ratio,
+                time: r.time,
+                steps: r.steps,
                 ..Default::default()
             };
             out.rows.extend(judge(
