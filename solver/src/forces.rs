@@ -155,7 +155,7 @@ pub fn element_loop(
                 *out = acc;
             });
         });
-        for ch in g.chunks.iter_mut() {
+        for ch in &g.chunks {
             if let Some(e) = &ch.error {
                 return Err(e.clone());
             }

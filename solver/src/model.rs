@@ -281,7 +281,15 @@ impl Model {
             };
             let mut scale = Vec::with_capacity(n);
             let lambda2mu = rho * c0 * c0;
-            let two_mu = 2.0 * law.initial_shear_modulus();
+            // Hourglass scaling of the part (see `HourglassModulus`): the stiffness form's
+            // modulus, and the factor on c of the viscous form.
+            let (hg_modulus, hg_c_ratio) = match form {
+                Formulation::OnePoint(hg) if hg.modulus == HourglassModulus::Shear => {
+                    let two_mu = 2.0 * law.initial_shear_modulus();
+                    (two_mu, (two_mu / lambda2mu).sqrt())
+                }
+                _ => (lambda2mu, 1.0),
+            };
             for &e in &elems {
                 let conn = mesh.elements[e as usize];
                 let x: [[f64; 3]; 8] = std::array::from_fn(|a| mesh.nodes[conn[a] as usize]);
@@ -306,21 +314,16 @@ impl Model {
                                     bb += b * b;
                                 }
                             }
-                            let modulus = match hg.modulus {
-                                HourglassModulus::PWave => lambda2mu,
-                                HourglassModulus::Shear => two_mu,
-                            };
                             g.hg_scale
-                                .push(hg.coefficient * modulus * bb / (3.0 * geo.volume) / 64.0);
+                                .push(hg.coefficient * hg_modulus * bb / (3.0 * geo.volume) / 64.0);
                         } else {
-                            // The kernel multiplies by the current wave speed c; the shear
-                            // form scales c by sqrt(2 mu0 / (rho c0^2)).
-                            let ratio = match hg.modulus {
-                                HourglassModulus::PWave => 1.0,
-                                HourglassModulus::Shear => (two_mu / lambda2mu).sqrt(),
-                            };
+                            // The kernel multiplies by the current wave speed c.
                             g.hg_scale.push(
-                                hg.coefficient * rho * geo.volume.powf(2.0 / 3.0) * 0.25 * ratio,
+                                hg.coefficient
+                                    * rho
+                                    * geo.volume.powf(2.0 / 3.0)
+                                    * 0.25
+                                    * hg_c_ratio,
                             );
                         }
                     }

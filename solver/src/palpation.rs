@@ -14,6 +14,7 @@
 //! a tumour the liver law with its shear and Prony moduli scaled by the tumour's stiffness
 //! factor (so its Poisson ratio and relaxation times stay the liver's).
 
+use crate::element::{HourglassForm, HourglassModulus};
 use crate::output::history::{column, read_history};
 use crate::phantom::{DEFAULT_VOXEL, PAPER_VOXEL};
 use std::fmt::Write;
@@ -55,22 +56,33 @@ impl ElementChoice {
         ElementChoice::OnePointStiffnessShear,
         ElementChoice::FullFbar,
     ];
-    /// Scene keys of the choice.
-    fn scene_keys(&self) -> &'static str {
+    /// The hourglass control of a one-point choice; `None` for F-bar.
+    pub fn hourglass(&self) -> Option<(HourglassForm, HourglassModulus)> {
+        use HourglassForm::{Stiffness, Viscous};
+        use HourglassModulus::{PWave, Shear};
         match self {
-            ElementChoice::OnePointViscous => {
-                "formulation = \"one_point\", hourglass = \"viscous\""
-            }
-            ElementChoice::OnePointStiffness => {
-                "formulation = \"one_point\", hourglass = \"stiffness\""
-            }
-            ElementChoice::OnePointViscousShear => {
-                "formulation = \"one_point\", hourglass = \"viscous\", hourglass_modulus = \"shear\""
-            }
-            ElementChoice::OnePointStiffnessShear => {
-                "formulation = \"one_point\", hourglass = \"stiffness\", hourglass_modulus = \"shear\""
-            }
-            ElementChoice::FullFbar => "formulation = \"full_fbar\"",
+            ElementChoice::OnePointViscous => Some((Viscous, PWave)),
+            ElementChoice::OnePointStiffness => Some((Stiffness, PWave)),
+            ElementChoice::OnePointViscousShear => Some((Viscous, Shear)),
+            ElementChoice::OnePointStiffnessShear => Some((Stiffness, Shear)),
+            ElementChoice::FullFbar => None,
+        }
+    }
+    /// Scene keys of the choice.
+    fn scene_keys(&self) -> String {
+        match self.hourglass() {
+            None => "formulation = \"full_fbar\"".into(),
+            Some((form, modulus)) => format!(
+                "formulation = \"one_point\", hourglass = \"{}\", hourglass_modulus = \"{}\"",
+                match form {
+                    HourglassForm::Viscous => "viscous",
+                    HourglassForm::Stiffness => "stiffness",
+                },
+                match modulus {
+                    HourglassModulus::PWave => "p_wave",
+                    HourglassModulus::Shear => "shear",
+                }
+            ),
         }
     }
     /// Short name for tables.

@@ -84,9 +84,20 @@ pub struct RunSummary {
     pub frames: usize,
     /// Elements eroded by their law's failure criterion.
     pub eroded_elements: u64,
-    /// The first eroded element: (element, part, time in s).
+    /// The first eroded element.
     #[serde(skip_serializing_if = "Option::is_none")]
-    pub first_eroded: Option<(u32, String, f64)>,
+    pub first_eroded: Option<ErodedElement>,
+}
+
+/// An eroded element, for the summary.
+#[derive(Clone, Debug, Serialize)]
+pub struct ErodedElement {
+    /// Element id.
+    pub element: u32,
+    /// Its part.
+    pub part: String,
+    /// Simulated time of the erosion (s).
+    pub time: f64,
 }
 
 /// Progress information for a progress bar.
@@ -451,8 +462,12 @@ pub fn run_scene(
             .collect(),
         threads: rayon::current_num_threads(),
         frames: series.len(),
-        eroded_elements: sim.eroded.0,
-        first_eroded: sim.eroded.1.map(|(e, t)| (e, sim.part_of(e), t)),
+        eroded_elements: sim.erosion.count,
+        first_eroded: sim.erosion.first.map(|(element, time)| ErodedElement {
+            element,
+            part: sim.part_of(element),
+            time,
+        }),
     };
     if let Ok(js) = serde_json::to_string_pretty(&summary) {
         if let Err(e) =

@@ -230,13 +230,22 @@ pub struct Simulation {
     pub residual: f64,
     /// Stage timers.
     pub timers: Vec<StageTime>,
-    /// Elements eroded so far, and the first one with its erosion time (s).
-    pub eroded: (u64, Option<(u32, f64)>),
+    /// Elements eroded so far.
+    pub erosion: Erosion,
     totals: ElementTotals,
     initialised: bool,
     hg_dissipated: f64,
     scratch_x: Vec<[f64; 3]>,
     scratch_targets: Vec<f64>,
+}
+
+/// Elements eroded by their law's failure criterion.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Erosion {
+    /// How many so far.
+    pub count: u64,
+    /// The first one (global id) and the time it eroded (s).
+    pub first: Option<(u32, f64)>,
 }
 
 const T_ELEMENTS: usize = 0;
@@ -357,7 +366,7 @@ impl Simulation {
             ke_half_prev: 0.0,
             residual: f64::INFINITY,
             timers,
-            eroded: (0, None),
+            erosion: Erosion::default(),
             totals: ElementTotals::default(),
             initialised: false,
             hg_dissipated: 0.0,
@@ -452,13 +461,11 @@ impl Simulation {
             reason,
         })?;
         self.totals = tot;
-        if tot.newly_eroded > 0 {
-            self.eroded.0 += tot.newly_eroded as u64;
-            if self.eroded.1.is_none() {
-                self.eroded.1 = tot.first_eroded.map(|e| (e, self.time));
-            }
+        self.erosion.count += tot.newly_eroded as u64;
+        if self.erosion.first.is_none() {
+            self.erosion.first = tot.first_eroded.map(|e| (e, self.time));
         }
-        if tot.dt_min.is_infinite() && self.eroded.0 > 0 {
+        if tot.dt_min.is_infinite() && self.erosion.count > 0 {
             // Every element has eroded: the nodes fly free, keep the last step.
             self.dt_next = self.dt_prev;
         } else {

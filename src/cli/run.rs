@@ -46,11 +46,13 @@ pub fn print_summary(s: &RunSummary) {
             m.part, m.physical_kg, m.added_kg, m.added_percent
         );
     }
-    if let Some((e, part, t)) = &s.first_eroded {
+    if let Some(e) = &s.first_eroded {
         println!(
-            "  eroded elements: {} (the first, element {e} of part `{part}`, at {:.4} ms)",
+            "  eroded elements: {} (the first, element {} of part `{}`, at {:.4} ms)",
             s.eroded_elements,
-            t * 1e3
+            e.element,
+            e.part,
+            e.time * 1e3
         );
     }
 }
