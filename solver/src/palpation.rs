@@ -108,7 +108,7 @@ impl std::str::FromStr for ElementChoice {
             "1pt-stiffness-shear" | "stiffness-shear" => Ok(ElementChoice::OnePointStiffnessShear),
             "full_fbar" | "full-fbar" | "full" => Ok(ElementChoice::FullFbar),
             o => Err(format!(
-                "unknown element formulation `{o}` (1pt-viscous, 1pt-stiffness, \
+                "unknown element formulation `{o}` (one_point, 1pt-viscous, 1pt-stiffness, \
                  1pt-viscous-shear, 1pt-stiffness-shear, full_fbar)"
             )),
         }
