@@ -33,6 +33,14 @@
 //! follows the relaxation with a lag error about `time_constant * |dR/dt|_relax`. Saturation at
 //! `approach_speed` bounds the speed in every phase, so a wrong stiffness estimate can never drive
 //! the indenter away. Keep `filter_time` a few times below `time_constant` for stability.
+//!
+//! The controller holds the force on whatever the body does: on a body that creeps at rate
+//! `v_c` at constant load it follows the creep with the lag error `k_s * time_constant * v_c`,
+//! and on a body that collapses it keeps pushing. A held load on one-point hexahedra with
+//! *viscous* hourglass control is such a case (the hourglass modes resist only rates, so the
+//! elements under the indenter drift and flatten during a hold); for force-controlled holds use
+//! stiffness hourglass control or the F-bar element (`solver/tests/contact_force_control.rs`
+//! measures both, and checks that the depth holds still).
 
 use serde::Deserialize;
 
