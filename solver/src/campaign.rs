@@ -47,7 +47,7 @@
 //!
 //! [solver]
 //! element = "one_point"            # one_point | stiffness | full_fbar
-//! dt_factor = 0.75
+//! dt_factor = 0.9
 //! # mass_scaling = "4 us"          # selective mass scaling target step (off by default)
 //! # mass_scaling_limit = 0.05
 //! vtk = false                      # VTK frames of every run (off: only the probe files)

@@ -172,8 +172,8 @@ pub fn element_loop(
                     tot.first_eroded.get_or_insert(g.elements[le as usize]);
                 }
             }
-            if ch.dt_min < tot.dt_min {
-                tot.dt_min = ch.dt_min;
+            if ch.dt_min * g.dt_kappa < tot.dt_min {
+                tot.dt_min = ch.dt_min * g.dt_kappa;
                 tot.dt_elem = ch.dt_elem;
             }
             tot.hg_stored += ch.hg_stored;

@@ -15,7 +15,7 @@
 //! The added mass is reported per part.
 
 use crate::element::max_face_area;
-use crate::element::{Formulation, HourglassForm, HourglassModulus};
+use crate::element::{surface_mode_factor, Formulation, HourglassForm, HourglassModulus};
 use crate::hex::{element_geometry, hourglass_gamma};
 use crate::mesh::Mesh;
 use material::Material;
@@ -153,6 +153,10 @@ pub struct Group {
     pub chunks: Vec<ChunkOut>,
     /// Eroded flags (empty unless the law can fail).
     pub eroded: Vec<bool>,
+    /// Surface-mode factor of the part's stable step (see
+    /// [`crate::element::surface_mode_factor`]); the element loop multiplies the group's
+    /// smallest `L / c` by it.
+    pub dt_kappa: f64,
 }
 
 /// Elements per parallel chunk. Fixed, so partial sums are formed in the same order for any
@@ -278,9 +282,11 @@ impl Model {
                 slot_offset,
                 chunks: vec![ChunkOut::default(); n.div_ceil(CHUNK)],
                 eroded: Vec::new(),
+                dt_kappa: 1.0,
             };
             let mut scale = Vec::with_capacity(n);
             let lambda2mu = rho * c0 * c0;
+            g.dt_kappa = surface_mode_factor(lambda2mu, law.initial_shear_modulus());
             // Hourglass scaling of the part (see `HourglassModulus`): the stiffness form's
             // modulus, and the factor on c of the viscous form.
             let (hg_modulus, hg_c_ratio) = match form {
@@ -333,7 +339,7 @@ impl Model {
                         g.gp_weight.push(geo.gp_weight);
                     }
                 }
-                let dte = initial_element_dt(&x, geo.volume, c0);
+                let dte = g.dt_kappa * initial_element_dt(&x, geo.volume, c0);
                 if dte < initial_dt.0 {
                     initial_dt = (dte, e);
                 }

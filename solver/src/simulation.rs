@@ -25,7 +25,11 @@ use crate::bc::{Constraint, Kinematic, NodalLoad};
 use crate::element::{BulkViscosity, StepInput};
 use crate::forces::{element_loop, gather, ElementTotals};
 use crate::model::{Model, SolverError};
+use rayon::prelude::*;
 use std::time::{Duration, Instant};
+
+/// Nodes per chunk of the parallel update (fixed, so sums are thread-count independent).
+const NODE_CHUNK: usize = 2048;
 
 /// Energies at the current time (J).
 #[derive(Clone, Copy, Debug, Default)]
@@ -130,19 +134,18 @@ pub trait ForceStage: Send {
     }
 }
 
-/// Default time-step safety factor: dt = factor * min_e L_e / c_e with L_e = V / A_max.
+/// Default time-step safety factor: dt = factor * min_e kappa_p L_e / c_e with L_e = V / A_max
+/// and kappa_p the part's surface-mode factor ([`crate::element::surface_mode_factor`]).
 ///
-/// LS-DYNA and OpenRadioss use 0.9. That estimate is exact for a 1-D dilatational mode, but a
-/// nearly incompressible material excites the 3-D dilatational mode of a hexahedron, whose
-/// frequency is up to sqrt(3 K / (K + 4G/3)) times higher (Flanagan and Belytschko 1984, the
-/// element eigenvalue bound), and viscous hourglass control adds damping at the highest
-/// frequencies. Measured on a regular 20 x 15 x 10 block of the paper's flesh (K/G = 5e4,
-/// `palpa run` with a small top load, 1.5 ms): one-point with viscous hourglass control is stable
-/// at 0.80 and unstable at 0.85; with stiffness hourglass control and fully integrated F-bar,
-/// stable at 0.85 and unstable at 0.90. palpa therefore defaults to 0.75, which also leaves a
-/// margin for the smoothed (distorted) phantom meshes. A run that goes unstable anyway stops
-/// with an error (negative internal energy) instead of producing garbage.
-pub const DEFAULT_DT_FACTOR: f64 = 0.75;
+/// 0.9, as in LS-DYNA and OpenRadioss. Without kappa the estimate L / c is exact only in the
+/// interior of a mesh: the free-surface modes of a nearly incompressible solid are up to 1/0.825
+/// times faster, and a regular block of the paper's flesh (K/G = 5e4) or of a nu = 0.49
+/// neo-Hookean solid went unstable within 30 steps at factors 0.85-0.9 (a linear-elastic
+/// nu = 0.49 block too, with bulk viscosity and hourglass control off, so neither causes it).
+/// With kappa, 0.9 leaves the usual 10 % margin for any Poisson ratio
+/// (`solver/tests/stable_step.rs`). A run that goes unstable anyway stops with an error
+/// (negative internal energy) instead of producing garbage.
+pub const DEFAULT_DT_FACTOR: f64 = 0.9;
 
 /// Settings of the time loop.
 #[derive(Clone, Debug)]
@@ -237,6 +240,7 @@ pub struct Simulation {
     hg_dissipated: f64,
     scratch_x: Vec<[f64; 3]>,
     scratch_targets: Vec<f64>,
+    scratch_partials: Vec<[f64; 10]>,
 }
 
 /// Elements eroded by their law's failure criterion.
@@ -372,6 +376,7 @@ impl Simulation {
             hg_dissipated: 0.0,
             scratch_x: vec![[0.0; 3]; nn],
             scratch_targets: Vec::new(),
+            scratch_partials: Vec::new(),
         })
     }
 
@@ -584,50 +589,72 @@ impl Simulation {
                 Kinematic::Fixed => 0.0,
             });
         }
-        let mut s = [0.0f64; 10];
+        // Nodes are updated in parallel chunks of fixed size; each chunk's energy sums are
+        // reduced serially in chunk order, so the result is the same for any thread count.
         // s: 0 w_int_old 1 w_int_new 2 w_ext_old 3 w_ext_new 4 w_damp_old 5 w_damp_new 6 ke 7 ke_half 8 res2 9 fint2
-        for n in 0..self.u.len() {
-            let m = self.model.mass[n];
-            for d in 0..3 {
-                let v_old = self.v[n][d];
-                let fi = self.f_int[n][d];
-                let fe = self.f_ext[n][d];
-                let fd = if damping { alpha * m * v_old } else { 0.0 };
-                let fnet = fe - fi - fd;
-                let code = self.dof_code[n * 3 + d];
-                let (v_new, r) = if code == 0 {
-                    (v_old + dt_avg * fnet / m, 0.0)
-                } else {
-                    let v_new = match code {
-                        1 => 0.0,
-                        k => {
-                            let tgt = targets[(k - 2) as usize];
-                            match self.prescribed[(k - 2) as usize].kind {
-                                Kinematic::Displacement(_) => (tgt - self.u[n][d]) / dt,
-                                _ => tgt,
-                            }
+        let nn = self.u.len();
+        let partials = &mut self.scratch_partials;
+        partials.clear();
+        partials.resize(nn.div_ceil(NODE_CHUNK), [0.0; 10]);
+        let (mass, f_int, f_ext) = (&self.model.mass, &self.f_int, &self.f_ext);
+        let (dof_code, prescribed, targets) = (&self.dof_code, &self.prescribed, &*targets);
+        self.u
+            .par_chunks_mut(NODE_CHUNK)
+            .zip(self.v.par_chunks_mut(NODE_CHUNK))
+            .zip(self.reaction.par_chunks_mut(NODE_CHUNK))
+            .zip(partials.par_iter_mut())
+            .enumerate()
+            .for_each(|(ci, (((uc, vc), rc), s))| {
+                for k in 0..uc.len() {
+                    let n = ci * NODE_CHUNK + k;
+                    let m = mass[n];
+                    for d in 0..3 {
+                        let v_old = vc[k][d];
+                        let fi = f_int[n][d];
+                        let fe = f_ext[n][d];
+                        let fd = if damping { alpha * m * v_old } else { 0.0 };
+                        let fnet = fe - fi - fd;
+                        let code = dof_code[n * 3 + d];
+                        let (v_new, r) = if code == 0 {
+                            (v_old + dt_avg * fnet / m, 0.0)
+                        } else {
+                            let v_new = match code {
+                                1 => 0.0,
+                                c => {
+                                    let tgt = targets[(c - 2) as usize];
+                                    match prescribed[(c - 2) as usize].kind {
+                                        Kinematic::Displacement(_) => (tgt - uc[k][d]) / dt,
+                                        _ => tgt,
+                                    }
+                                }
+                            };
+                            (v_new, m * (v_new - v_old) / dt_avg - fnet)
+                        };
+                        rc[k][d] = r;
+                        if code == 0 {
+                            s[8] += fnet * fnet;
                         }
-                    };
-                    (v_new, m * (v_new - v_old) / dt_avg - fnet)
-                };
-                self.reaction[n][d] = r;
-                if code == 0 {
-                    s[8] += fnet * fnet;
+                        s[9] += fi * fi;
+                        let h_old = 0.5 * dt_old * v_old;
+                        let h_new = 0.5 * dt * v_new;
+                        s[0] += fi * h_old;
+                        s[1] += fi * h_new;
+                        s[2] += (fe + r) * h_old;
+                        s[3] += (fe + r) * h_new;
+                        s[4] += fd * h_old;
+                        s[5] += fd * h_new;
+                        let vn = 0.5 * (v_old + v_new);
+                        s[6] += 0.5 * m * vn * vn;
+                        s[7] += 0.5 * m * v_new * v_new;
+                        vc[k][d] = v_new;
+                        uc[k][d] += dt * v_new;
+                    }
                 }
-                s[9] += fi * fi;
-                let h_old = 0.5 * dt_old * v_old;
-                let h_new = 0.5 * dt * v_new;
-                s[0] += fi * h_old;
-                s[1] += fi * h_new;
-                s[2] += (fe + r) * h_old;
-                s[3] += (fe + r) * h_new;
-                s[4] += fd * h_old;
-                s[5] += fd * h_new;
-                let vn = 0.5 * (v_old + v_new);
-                s[6] += 0.5 * m * vn * vn;
-                s[7] += 0.5 * m * v_new * v_new;
-                self.v[n][d] = v_new;
-                self.u[n][d] += dt * v_new;
+            });
+        let mut s = [0.0f64; 10];
+        for p in partials.iter() {
+            for (a, b) in s.iter_mut().zip(p) {
+                *a += b;
             }
         }
         // Energies at t^n.

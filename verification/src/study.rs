@@ -127,7 +127,7 @@ fn plan(quick: bool) -> (PalpationSetup, Vec<(String, String, PalpationSetup)>) 
             },
         ));
     }
-    for f in [0.5, 0.75, 0.85] {
+    for f in [0.5, 0.75, 0.9] {
         v.push((
             "dt factor".into(),
             format!("{f}"),

@@ -62,7 +62,7 @@ pub struct SceneSpec {
 pub struct RunSpec {
     /// End time.
     pub end_time: Time,
-    /// Time-step safety factor (default 0.75, see [`crate::simulation::DEFAULT_DT_FACTOR`]).
+    /// Time-step safety factor (default 0.9, see [`crate::simulation::DEFAULT_DT_FACTOR`]).
     pub dt_factor: Option<Number>,
     /// Largest step.
     pub dt_max: Option<Time>,
