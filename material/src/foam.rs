@@ -61,7 +61,7 @@
 //! `c = 1374 m/s`.
 
 use crate::law::{checked_jacobian, Law, LawError, Mat3, Response};
-use crate::principal::{c_minus_identity, ddot6, mat_from_sym6, Principal, Sym6};
+use crate::principal::{all_finite6, ddot6, mat_from_sym6, Principal, Sym6};
 
 /// A uniaxial nominal stress-stretch curve.
 #[derive(Clone, Debug, PartialEq)]
@@ -311,7 +311,7 @@ impl Law for Foam {
     }
     fn initial_wave_speed(&self) -> f64 {
         let m = self.bulk + 2.0 / 3.0 * self.f_and_slope(0.0).1;
-        (m * damping_factor(self.damping * self.shear / m) / self.rho).sqrt()
+        damped_wave_speed(m, self.damping * self.shear, self.rho)
     }
 
     fn initial_shear_modulus(&self) -> f64 {
@@ -335,7 +335,7 @@ impl Law for Foam {
             self.bulk * (1.0 - 2.0 * p.ln_j).max(1.0) + 2.0 / 3.0 * d0.max(d1).max(d2) + 2.0 * tmax;
         let mut dissipation = 0.0;
         if self.damping > 0.0 {
-            let c1 = c_minus_identity(f);
+            let c1 = &p.c_minus_i;
             let prev: &mut [f64] = &mut history[..6];
             let mut de: Sym6 = [0.0; 6];
             for k in 0..6 {
@@ -354,14 +354,16 @@ impl Law for Foam {
                 c * de[5],
             ];
             dissipation = ddot6(&sv, &de);
-            pk2 += mat_from_sym6(&sv);
+            for k in 0..6 {
+                pk2[k] += sv[k];
+            }
         }
-        let wave_speed = (m * damping_factor(self.damping * self.shear / m) / self.rho).sqrt();
-        if !(wave_speed.is_finite() && pk2.iter().all(|x| x.is_finite())) {
+        let wave_speed = damped_wave_speed(m, self.damping * self.shear, self.rho);
+        if !(wave_speed.is_finite() && all_finite6(&pk2)) {
             return Err(LawError::NotFinite("simplified_rubber"));
         }
         Ok(Response {
-            pk2,
+            pk2: mat_from_sym6(&pk2),
             wave_speed,
             dissipation,
             failed: false,
@@ -369,12 +371,14 @@ impl Law for Foam {
     }
 }
 
-/// `1 / (sqrt(1 + xi^2) - xi)^2`: the modulus factor equivalent to the stable-step reduction of
-/// stiffness-proportional damping with fraction of critical `xi` in the highest mode.
+/// `sqrt(M / rho / (sqrt(1 + xi^2) - xi)^2)` with `xi = D / M`, `D = MU G`: the wave speed whose
+/// stable step carries the reduction of stiffness-proportional damping with fraction of critical
+/// `xi` in the highest mode (module doc, "Wave speed"). Since `(sqrt(1 + xi^2) - xi)(sqrt(1 + xi^2) + xi) = 1`,
+/// it equals `(sqrt(M^2 + D^2) + D) / sqrt(M rho)`: no cancellation, and the two square roots
+/// run side by side.
 #[inline(always)]
-fn damping_factor(xi: f64) -> f64 {
-    let r = (1.0 + xi * xi).sqrt() - xi;
-    1.0 / (r * r)
+fn damped_wave_speed(m: f64, d: f64, rho: f64) -> f64 {
+    ((m * m + d * d).sqrt() + d) / (m * rho).sqrt()
 }
 
 #[cfg(test)]

@@ -30,7 +30,7 @@
 //!
 //! Powers are evaluated as `exp(alpha ln lb)` from the logarithmic stretches, so no
 //! intermediate overflows: alpha = 19.07 at stretch 2 is 5.5e5, alpha = -10.96 at 0.3 is 5.4e5.
-//! Principal stretches come from the shared Jacobi kernel ([`crate::principal`]); the stress
+//! Principal stretches come from the shared eigen-kernel ([`crate::principal`]); the stress
 //! formula has no division by stretch differences, so equal or nearly equal stretches are exact.
 //!
 //! # Viscous part (paper eqs. 2-3)
@@ -53,6 +53,12 @@
 //! h_i^{n+1} = exp(-dt/tau_i) h_i^n + 2 G_i (1 - exp(-dt/tau_i)) / (dt/tau_i) (E^{n+1} - E^n).
 //! ```
 //!
+//! The factors `exp(-dt/tau_i)`, `2 G_i (1 - exp(-dt/tau_i)) / (dt/tau_i)` and the dissipation
+//! weights `dt / (4 G_i tau_i)` depend only on the law and `dt`; each thread keeps the last set it
+//! computed, keyed on the law's identity and the bits of `dt`, so the `exp_m1` and the divisions
+//! run once per law and step length instead of at every point (a hit returns exactly the
+//! recomputed numbers: results are the same with or without the cache).
+//!
 //! History per point: 6 numbers per term (`h_i`, Sym6) followed by the 6 of `E^n`.
 //! Decay constants `beta_i = 1/tau_i` (LS-DYNA cards) are accepted by the scene card.
 //!
@@ -72,10 +78,13 @@
 //! ```
 //!
 //! At the reference state this is `K + 4/3 mu0 + M_visc(1)` exactly (when every
-//! `mu_p alpha_p > 0`).
+//! `mu_p alpha_p > 0`). `l_max^4` is the square of the largest eigenvalue of `C`.
+
+use std::cell::RefCell;
+use std::sync::atomic::{AtomicU64, Ordering};
 
 use crate::law::{checked_jacobian, Law, LawError, Mat3, Response};
-use crate::principal::{c_minus_identity, ddot6, mat_from_sym6, Principal, Sym6};
+use crate::principal::{all_finite6, ddot6, mat_from_sym6, Principal, Sym6};
 
 /// Most Ogden terms a card may give.
 pub const MAX_TERMS: usize = 6;
@@ -114,6 +123,40 @@ pub struct Ogden {
     prony: [PronyTerm; MAX_PRONY],
     /// Strain the Prony series acts on.
     pub prony_on: PronyOn,
+    /// `|mu_p alpha_p| / 2` (Pa), for the stretch-stiffened shear modulus bound.
+    half_abs_mu_alpha: [f64; MAX_TERMS],
+    /// `sum_i G_i` (Pa).
+    prony_sum: f64,
+    /// Identifies this law's (immutable, private) Prony terms in the per-thread cache of step
+    /// factors; clones share it, as they share the terms.
+    id: u64,
+}
+
+/// Source of [`Ogden`] identities.
+static NEXT_ID: AtomicU64 = AtomicU64::new(1);
+
+/// The Prony step factors of one law and one step length, per term `i`:
+/// `a_i = exp(-dt/tau_i)`, `g_i = 2 G_i (1 - a_i) / (dt/tau_i)` (`a_i = 1`, `g_i = 2 G_i` for
+/// `dt = 0`) and `w_i = dt / (4 G_i tau_i)` (the dissipation weight).
+#[derive(Clone, Copy)]
+struct PronyFactors {
+    /// Law id and `dt.to_bits()` the factors were computed for (id 0: empty).
+    key: (u64, u64),
+    f: [[f64; 3]; MAX_PRONY],
+}
+
+thread_local! {
+    /// The last Prony step factors this thread computed. An explicit step evaluates every
+    /// integration point of a group with the same `dt`, so this saves the `exp_m1` and the
+    /// divisions of every term at all but the first point. A hit returns exactly the numbers a
+    /// recomputation would (a pure function of the key), so results do not depend on the
+    /// cache's state or on the thread schedule.
+    static PRONY_CACHE: RefCell<PronyFactors> = const {
+        RefCell::new(PronyFactors {
+            key: (0, 0),
+            f: [[0.0; 3]; MAX_PRONY],
+        })
+    };
 }
 
 impl Ogden {
@@ -183,10 +226,16 @@ impl Ogden {
             np: prony.len(),
             prony: [PronyTerm::default(); MAX_PRONY],
             prony_on,
+            half_abs_mu_alpha: [0.0; MAX_TERMS],
+            prony_sum: prony.iter().map(|t| t.modulus).sum(),
+            id: NEXT_ID.fetch_add(1, Ordering::Relaxed),
         };
         o.mu[..mu.len()].copy_from_slice(mu);
         o.alpha[..alpha.len()].copy_from_slice(alpha);
         o.prony[..prony.len()].copy_from_slice(prony);
+        for k in 0..mu.len() {
+            o.half_abs_mu_alpha[k] = 0.5 * (mu[k] * alpha[k]).abs();
+        }
         Ok(o)
     }
 
@@ -236,6 +285,55 @@ impl Ogden {
         }
     }
 
+    /// The Prony step factors `(a_i, g_i, w_i)` for a step `dt` (see [`PronyFactors`]).
+    fn compute_prony_factors(&self, dt: f64) -> PronyFactors {
+        let mut f = [[0.0; 3]; MAX_PRONY];
+        for (i, term) in self.prony().iter().enumerate() {
+            let x = dt / term.tau;
+            let (a, b) = if x > 0.0 {
+                let em1 = (-x).exp_m1();
+                (1.0 + em1, -em1 / x)
+            } else {
+                (1.0, 1.0)
+            };
+            f[i] = [
+                a,
+                2.0 * term.modulus * b,
+                dt / (4.0 * term.modulus * term.tau),
+            ];
+        }
+        PronyFactors {
+            key: (self.id, dt.to_bits()),
+            f,
+        }
+    }
+
+    /// Update the Prony history for the strain increment `de` over a step `dt`; returns the
+    /// summed viscous stresses `sum_i h_i` and the step's dissipation.
+    #[inline(always)]
+    fn prony_update(&self, dt: f64, de: &Sym6, hs: &mut [f64]) -> (Sym6, f64) {
+        PRONY_CACHE.with(|cache| {
+            let key = (self.id, dt.to_bits());
+            if cache.borrow().key != key {
+                *cache.borrow_mut() = self.compute_prony_factors(dt);
+            }
+            let cache = cache.borrow();
+            let mut sv: Sym6 = [0.0; 6];
+            let mut dissipation = 0.0;
+            for (h, &[a, g, w]) in hs.chunks_exact_mut(6).zip(&cache.f[..self.np]) {
+                let old: Sym6 = [h[0], h[1], h[2], h[3], h[4], h[5]];
+                let mut new: Sym6 = [0.0; 6];
+                for k in 0..6 {
+                    new[k] = a * old[k] + g * de[k];
+                    sv[k] += new[k];
+                }
+                h.copy_from_slice(&new);
+                dissipation += w * (ddot6(&old, &old) + ddot6(&new, &new));
+            }
+            (sv, dissipation)
+        })
+    }
+
     /// Principal Kirchhoff stresses of the elastic (long-term) part, the stretch-stiffened shear
     /// modulus bound and the largest |tau_iso|.
     #[inline(always)]
@@ -250,7 +348,7 @@ impl Ogden {
             tau[0] += m * (e[0] - mean);
             tau[1] += m * (e[1] - mean);
             tau[2] += m * (e[2] - mean);
-            mu_eff += 0.5 * (m * a).abs() * e[0].max(e[1]).max(e[2]);
+            mu_eff += self.half_abs_mu_alpha[k] * e[0].max(e[1]).max(e[2]);
         }
         let tmax = tau[0].abs().max(tau[1].abs()).max(tau[2].abs());
         let pk = self.bulk * p.ln_j;
@@ -313,7 +411,7 @@ impl Law for Ogden {
         let mut m = self.bulk * (1.0 - 2.0 * p.ln_j).max(1.0) + 4.0 / 3.0 * mu_eff + 2.0 * tmax;
         let mut dissipation = 0.0;
         if self.np > 0 {
-            let c1 = c_minus_identity(f);
+            let c1 = &p.c_minus_i;
             let mut e: Sym6 = [
                 0.5 * c1[0],
                 0.5 * c1[1],
@@ -335,39 +433,21 @@ impl Law for Ogden {
                 de[k] = e[k] - eprev[k];
                 eprev[k] = e[k];
             }
-            let mut sv: Sym6 = [0.0; 6];
-            let mut gsum = 0.0;
-            for (i, term) in self.prony[..self.np].iter().enumerate() {
-                let x = dt / term.tau;
-                let (a, b) = if x > 0.0 {
-                    let em1 = (-x).exp_m1();
-                    (1.0 + em1, -em1 / x)
-                } else {
-                    (1.0, 1.0)
-                };
-                let g2b = 2.0 * term.modulus * b;
-                let h: &mut [f64] = &mut hs[6 * i..6 * i + 6];
-                let old: Sym6 = [h[0], h[1], h[2], h[3], h[4], h[5]];
-                for k in 0..6 {
-                    h[k] = a * old[k] + g2b * de[k];
-                    sv[k] += h[k];
-                }
-                let new: Sym6 = [h[0], h[1], h[2], h[3], h[4], h[5]];
-                dissipation +=
-                    dt / (4.0 * term.modulus * term.tau) * (ddot6(&old, &old) + ddot6(&new, &new));
-                gsum += term.modulus;
+            let (sv, d) = self.prony_update(dt, &de, hs);
+            for k in 0..6 {
+                pk2[k] += sv[k];
             }
-            pk2 += mat_from_sym6(&sv);
-            let lmax = p.ln_stretch[0].max(p.ln_stretch[1]).max(p.ln_stretch[2]);
-            m += self.visc_modulus_factor() * gsum * (4.0 * lmax).exp().max(1.0);
+            dissipation = d;
+            // exp(4 ln l_max) = l_max^4.
+            let l2max = p.stretch_sq[0].max(p.stretch_sq[1]).max(p.stretch_sq[2]);
+            m += self.visc_modulus_factor() * self.prony_sum * (l2max * l2max).max(1.0);
         }
         let wave_speed = (m / self.rho).sqrt();
-        if !(wave_speed.is_finite() && pk2.iter().all(|x| x.is_finite()) && dissipation.is_finite())
-        {
+        if !(wave_speed.is_finite() && all_finite6(&pk2) && dissipation.is_finite()) {
             return Err(LawError::NotFinite("ogden"));
         }
         Ok(Response {
-            pk2,
+            pk2: mat_from_sym6(&pk2),
             wave_speed,
             dissipation,
             failed: false,
@@ -541,6 +621,58 @@ mod tests {
         .unwrap();
         let c0 = m.initial_wave_speed();
         assert!((c0 - ((1e6 + 4.0 / 3.0 * 2.0 + 2.0 * g) / 1000.0f64).sqrt()).abs() < 1e-9);
+    }
+
+    #[test]
+    fn prony_factors_follow_the_law_and_the_step() {
+        // Two laws with different relaxation times, evaluated in turn with changing steps on one
+        // thread: every update must use its own law's exp(-dt/tau) and dt.
+        let law = |tau: f64| {
+            Ogden::new(
+                "x",
+                1000.0,
+                &[2.0],
+                &[2.0],
+                1e6,
+                &[PronyTerm {
+                    modulus: 1000.0,
+                    tau,
+                }],
+                PronyOn::GreenLagrange,
+            )
+            .unwrap()
+        };
+        let laws = [law(1e-3), law(5e-2)];
+        let mut hist = [vec![0.0; 12], vec![0.0; 12]];
+        for k in 1..=12 {
+            let i = k % 2;
+            let dt = [1e-4, 3e-4, 0.0][(k / 2) % 3];
+            let g = 1e-3 * k as f64;
+            let f = Mat3::new(1.0, g, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0);
+            let h = &mut hist[i];
+            let (h_old, e_old) = (h[3], h[9]);
+            laws[i].evaluate(&f, dt, h).unwrap();
+            let x = dt / laws[i].prony()[0].tau;
+            let (a, b) = if x > 0.0 {
+                ((-x).exp(), (1.0 - (-x).exp()) / x)
+            } else {
+                (1.0, 1.0)
+            };
+            let want = a * h_old + 2.0 * 1000.0 * b * (0.5 * g - e_old);
+            assert!(
+                (h[3] - want).abs() <= 1e-12 * want.abs(),
+                "k={k}: {} vs {want}",
+                h[3]
+            );
+        }
+        // A clone shares the terms and may share the cached factors.
+        let c = laws[0].clone();
+        let f = Mat3::new(1.0, 0.01, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0);
+        let (mut h1, mut h2) = (vec![0.0; 12], vec![0.0; 12]);
+        let r1 = laws[0].evaluate(&f, 1e-4, &mut h1).unwrap();
+        let r2 = c.evaluate(&f, 1e-4, &mut h2).unwrap();
+        assert_eq!(r1.pk2, r2.pk2);
+        assert_eq!(h1, h2);
     }
 
     #[test]

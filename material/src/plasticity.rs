@@ -17,7 +17,7 @@
 //!
 //! # Return mapping
 //!
-//! Each step: trial `b_e^tr = F C_p^-1(n) F^T`, its spectral decomposition (shared Jacobi kernel),
+//! Each step: trial `b_e^tr = F C_p^-1(n) F^T`, its spectral decomposition (shared eigen-kernel),
 //! trial principal Hencky strains and Kirchhoff stresses, von Mises `q = sqrt(3/2) |dev tau|`.
 //! If `q_tr > sigma_y(eps_p^n)`, the exponential-map radial return solves
 //!
@@ -29,6 +29,11 @@
 //! piecewise-linear hardening curve the scalar equation is solved exactly, segment by segment, so
 //! the return is exact for linear (and piecewise-linear) hardening. Then
 //! `b_e = sum exp(2 eps_e,i) n_i (x) n_i`, `C_p^-1 = F^-1 b_e F^-T`, `S = F^-1 tau F^-T`.
+//! Computed as `S = sum_i tau_i m_i (x) m_i` with `m_i = F^-1 n_i` (`F^-1` from the cofactors and
+//! `J`), and, after a plastic step only, `C_p^-1 - I = F^-1 (b_e - b) F^-T` with
+//! `b_e - b = sum_i expm1(2 eps_e,i) n_i (x) n_i - (b - I)`, a difference of two accurate
+//! differences. The elastic test compares `q_tr^2` with `sigma_y^2`, so an elastic step takes no
+//! square root and leaves the history untouched.
 //!
 //! Hardening: `sigma_y(eps_p)` from a table of (effective plastic strain, yield stress), or from
 //! `E_t`: `sigma_y = sigma_y0 + H eps_p` with `H = E E_t / (E - E_t)`, which makes the uniaxial
@@ -43,7 +48,9 @@
 //! reports `failed` once `eps_p >= failure_strain`. Wave speed: `sqrt((K + 4/3 G) / rho)`.
 
 use crate::law::{checked_jacobian, Law, LawError, Mat3, Response};
-use crate::principal::{b_minus_identity, mat_from_sym6, spectral, spectral6, sym6, sym_eigen};
+use crate::principal::{
+    all_finite6, b_minus_identity, mat_from_sym6, sandwich6, spectral6, sym_eigen, Sym6,
+};
 
 /// Piecewise-linear J2 plasticity.
 #[derive(Clone, Debug)]
@@ -54,10 +61,9 @@ pub struct Plasticity {
     pub bulk: f64,
     /// Shear modulus G (Pa).
     pub shear: f64,
-    /// Hardening curve: (effective plastic strain, yield stress in Pa), first strain 0.
-    curve: Vec<(f64, f64)>,
-    /// Slope after the last point (Pa).
-    last_slope: f64,
+    /// Hardening curve: (effective plastic strain, yield stress in Pa, slope of the segment
+    /// that starts there in Pa), first strain 0; the last slope continues beyond the last point.
+    curve: Vec<(f64, f64, f64)>,
     /// Effective plastic strain at failure, if any.
     pub failure_strain: Option<f64>,
 }
@@ -118,12 +124,22 @@ impl Plasticity {
         if last_slope <= -3.0 * shear {
             return Err(format!("material `{name}`: the softening slope is steeper than 3G: the return mapping has no solution"));
         }
+        let curve = curve
+            .iter()
+            .enumerate()
+            .map(|(k, &(e, s))| {
+                let slope = match curve.get(k + 1) {
+                    Some(&(e1, s1)) => (s1 - s) / (e1 - e),
+                    None => last_slope,
+                };
+                (e, s, slope)
+            })
+            .collect();
         Ok(Plasticity {
             rho,
             bulk,
             shear,
-            curve: curve.to_vec(),
-            last_slope,
+            curve,
             failure_strain,
         })
     }
@@ -139,39 +155,36 @@ impl Plasticity {
         Ok(vec![(0.0, yield0), (1.0, yield0 + h)])
     }
 
-    /// Yield stress (Pa) at effective plastic strain `ep`, and the segment index.
+    /// Index of the hardening segment that contains effective plastic strain `ep`.
     #[inline(always)]
-    pub fn yield_stress(&self, ep: f64) -> f64 {
+    fn segment(&self, ep: f64) -> usize {
         let c = &self.curve;
         let mut k = 0;
         while k + 1 < c.len() && c[k + 1].0 <= ep {
             k += 1;
         }
-        let slope = if k + 1 < c.len() {
-            (c[k + 1].1 - c[k].1) / (c[k + 1].0 - c[k].0)
-        } else {
-            self.last_slope
-        };
-        c[k].1 + slope * (ep - c[k].0)
+        k
     }
 
-    /// Exact solution of `q_tr - 3 G dg - sigma_y(ep + dg) = 0` for piecewise-linear hardening.
+    /// Yield stress (Pa) at effective plastic strain `ep`.
     #[inline(always)]
-    fn return_map(&self, q_tr: f64, ep: f64) -> f64 {
+    pub fn yield_stress(&self, ep: f64) -> f64 {
+        let (e, s, slope) = self.curve[self.segment(ep)];
+        s + slope * (ep - e)
+    }
+
+    /// Exact solution of `q_tr - 3 G dg - sigma_y(ep + dg) = 0` for piecewise-linear hardening,
+    /// given `sy = sigma_y(ep)`.
+    #[inline(always)]
+    fn return_map(&self, q_tr: f64, ep: f64, sy: f64) -> f64 {
         let c = &self.curve;
         let g3 = 3.0 * self.shear;
-        let mut k = 0;
-        while k + 1 < c.len() && c[k + 1].0 <= ep {
-            k += 1;
-        }
+        let mut k = self.segment(ep);
         let mut e = ep;
-        let mut r = q_tr - self.yield_stress(ep);
+        let mut r = q_tr - sy;
         loop {
-            let (slope, end) = if k + 1 < c.len() {
-                ((c[k + 1].1 - c[k].1) / (c[k + 1].0 - c[k].0), c[k + 1].0)
-            } else {
-                (self.last_slope, f64::INFINITY)
-            };
+            let slope = c[k].2;
+            let end = c.get(k + 1).map_or(f64::INFINITY, |n| n.0);
             let d = r / (g3 + slope);
             if e + d <= end {
                 return e + d - ep;
@@ -211,15 +224,16 @@ impl Law for Plasticity {
 
     #[inline]
     fn evaluate(&self, f: &Mat3, _dt: f64, history: &mut [f64]) -> Result<Response, LawError> {
-        checked_jacobian(f)?;
+        let j = checked_jacobian(f)?;
         let ep = history[0];
-        let q = [
+        let q: Sym6 = [
             history[1], history[2], history[3], history[4], history[5], history[6],
         ];
         // b_e^tr - I = (b - I) + F Q F^T with Q = C_p^-1 - I.
-        let mut a = b_minus_identity(f);
+        let bm = b_minus_identity(f);
+        let mut a = bm;
         if q.iter().any(|x| *x != 0.0) {
-            let fq = sym6(&(f * mat_from_sym6(&q) * f.transpose()));
+            let fq = sandwich6(f, &q);
             for k in 0..6 {
                 a[k] += fq[k];
             }
@@ -236,14 +250,15 @@ impl Law for Plasticity {
         let m = ev_vol / 3.0;
         let mut dev = [eps[0] - m, eps[1] - m, eps[2] - m];
         let g2 = 2.0 * self.shear;
-        let q_tr =
-            1.5f64.sqrt() * g2 * (dev[0] * dev[0] + dev[1] * dev[1] + dev[2] * dev[2]).sqrt();
+        // q_tr^2 = 3/2 |2 G dev eps|^2, compared squared: no square root on the elastic path.
+        let q_tr2 = 1.5 * g2 * g2 * (dev[0] * dev[0] + dev[1] * dev[1] + dev[2] * dev[2]);
         let sy = self.yield_stress(ep);
         let mut dissipation = 0.0;
         let mut ep_new = ep;
-        let plastic = q_tr > sy;
+        let plastic = q_tr2 > sy * sy;
         if plastic {
-            let dg = self.return_map(q_tr, ep);
+            let q_tr = q_tr2.sqrt();
+            let dg = self.return_map(q_tr, ep, sy);
             let factor = 1.0 - 3.0 * self.shear * dg / q_tr;
             for d in dev.iter_mut() {
                 *d *= factor;
@@ -253,26 +268,43 @@ impl Law for Plasticity {
         }
         let p = self.bulk * ev_vol;
         let tau = [g2 * dev[0] + p, g2 * dev[1] + p, g2 * dev[2] + p];
-        let fi = f.try_inverse().ok_or(LawError::NotFinite("singular F"))?;
-        let pk2 = fi * spectral(&tau, &n) * fi.transpose();
+        // F^-1 = cof(F)^T / J.
+        let ij = 1.0 / j;
+        let fi = Mat3::new(
+            (f[(1, 1)] * f[(2, 2)] - f[(1, 2)] * f[(2, 1)]) * ij,
+            (f[(0, 2)] * f[(2, 1)] - f[(0, 1)] * f[(2, 2)]) * ij,
+            (f[(0, 1)] * f[(1, 2)] - f[(0, 2)] * f[(1, 1)]) * ij,
+            (f[(1, 2)] * f[(2, 0)] - f[(1, 0)] * f[(2, 2)]) * ij,
+            (f[(0, 0)] * f[(2, 2)] - f[(0, 2)] * f[(2, 0)]) * ij,
+            (f[(0, 2)] * f[(1, 0)] - f[(0, 0)] * f[(1, 2)]) * ij,
+            (f[(1, 0)] * f[(2, 1)] - f[(1, 1)] * f[(2, 0)]) * ij,
+            (f[(0, 1)] * f[(2, 0)] - f[(0, 0)] * f[(2, 1)]) * ij,
+            (f[(0, 0)] * f[(1, 1)] - f[(0, 1)] * f[(1, 0)]) * ij,
+        );
+        // S = F^-1 tau F^-T = sum_i tau_i (F^-1 n_i) (x) (F^-1 n_i).
+        let pk2 = spectral6(&tau, &(fi * n));
         if plastic {
-            // C_p^-1 - I = F^-1 (b_e - I) F^-T + (C^-1 - I).
+            // C_p^-1 - I = F^-1 (b_e - b) F^-T, with b_e - b = (b_e - I) - (b - I): both
+            // differences are accurate at small strain, and an elastic step would return Q.
             let e2 = [
                 (2.0 * (dev[0] + m)).exp_m1(),
                 (2.0 * (dev[1] + m)).exp_m1(),
                 (2.0 * (dev[2] + m)).exp_m1(),
             ];
-            let bm = mat_from_sym6(&spectral6(&e2, &n));
-            let qn = sym6(&(fi * bm * fi.transpose() + fi * fi.transpose() - Mat3::identity()));
+            let mut d = spectral6(&e2, &n);
+            for k in 0..6 {
+                d[k] -= bm[k];
+            }
+            let qn = sandwich6(&fi, &d);
             history[0] = ep_new;
             history[1..7].copy_from_slice(&qn);
         }
         let failed = matches!(self.failure_strain, Some(fs) if ep_new >= fs);
-        if !pk2.iter().all(|x| x.is_finite()) {
+        if !all_finite6(&pk2) {
             return Err(LawError::NotFinite("piecewise_linear_plasticity"));
         }
         Ok(Response {
-            pk2,
+            pk2: mat_from_sym6(&pk2),
             wave_speed: self.initial_wave_speed(),
             dissipation,
             failed,
@@ -312,7 +344,7 @@ mod tests {
         )
         .unwrap();
         for (q, ep) in [(1.5, 0.0), (4.0, 0.0), (10.0, 0.05), (3.0, 0.25)] {
-            let dg = l.return_map(q, ep);
+            let dg = l.return_map(q, ep, l.yield_stress(ep));
             let r = q - 3.0 * dg - l.yield_stress(ep + dg);
             assert!(r.abs() < 1e-12, "q={q} ep={ep}: residual {r}");
             assert!(dg > 0.0);

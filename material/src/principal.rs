@@ -369,16 +369,22 @@ pub struct Principal {
     pub ln_j: f64,
     /// Reference (Lagrangian) principal directions `N_i`, as columns: eigenvectors of `C`.
     pub directions: Mat3,
+    /// `l_i^2`, the eigenvalues of `C`.
+    pub stretch_sq: [f64; 3],
     /// `1 / l_i^2`, the eigenvalues of `C^-1`.
     pub inv_stretch_sq: [f64; 3],
+    /// `C - I` (twice the Green-Lagrange strain), as Sym6: the tensor that was decomposed.
+    pub c_minus_i: Sym6,
 }
 
 impl Principal {
     /// Decompose `F` (which must have a positive determinant: check it first).
     #[inline(always)]
     pub fn of(f: &Mat3) -> Result<Principal, LawError> {
-        let (a, n) = sym_eigen(&c_minus_identity(f));
+        let c1 = c_minus_identity(f);
+        let (a, n) = sym_eigen(&c1);
         let mut ln = [0.0; 3];
+        let mut sq = [0.0; 3];
         let mut inv = [0.0; 3];
         for i in 0..3 {
             // a_i > -1 for det F > 0 up to round-off; refuse a collapsed direction.
@@ -386,13 +392,16 @@ impl Principal {
                 return Err(LawError::NotFinite("principal stretch collapsed to zero"));
             }
             ln[i] = 0.5 * a[i].ln_1p();
-            inv[i] = 1.0 / (1.0 + a[i]);
+            sq[i] = 1.0 + a[i];
+            inv[i] = 1.0 / sq[i];
         }
         Ok(Principal {
             ln_stretch: ln,
             ln_j: ln[0] + ln[1] + ln[2],
             directions: n,
+            stretch_sq: sq,
             inv_stretch_sq: inv,
+            c_minus_i: c1,
         })
     }
 
@@ -407,16 +416,33 @@ impl Principal {
         ]
     }
 
-    /// PK2 stress from principal Kirchhoff stresses: `S = sum_i tau_i / l_i^2 N_i (x) N_i`.
+    /// PK2 stress from principal Kirchhoff stresses, as Sym6:
+    /// `S = sum_i tau_i / l_i^2 N_i (x) N_i`.
     #[inline(always)]
-    pub fn pk2_from_kirchhoff(&self, tau: &[f64; 3]) -> Mat3 {
+    pub fn pk2_from_kirchhoff(&self, tau: &[f64; 3]) -> Sym6 {
         let c = [
             tau[0] * self.inv_stretch_sq[0],
             tau[1] * self.inv_stretch_sq[1],
             tau[2] * self.inv_stretch_sq[2],
         ];
-        spectral(&c, &self.directions)
+        spectral6(&c, &self.directions)
     }
+}
+
+/// `M S M^T` for a symmetric `S` given as Sym6, as Sym6.
+#[inline(always)]
+pub fn sandwich6(m: &Mat3, s: &Sym6) -> Sym6 {
+    // T = M S (row i of M times S), then (T M^T)_ij = T_i . M_j.
+    let row = |i: usize| mul6(s, [m[(i, 0)], m[(i, 1)], m[(i, 2)]]);
+    let t = [row(0), row(1), row(2)];
+    let e = |i: usize, j: usize| t[i][0] * m[(j, 0)] + t[i][1] * m[(j, 1)] + t[i][2] * m[(j, 2)];
+    [e(0, 0), e(1, 1), e(2, 2), e(0, 1), e(1, 2), e(2, 0)]
+}
+
+/// Whether every component of a Sym6 is finite.
+#[inline(always)]
+pub fn all_finite6(s: &Sym6) -> bool {
+    s.iter().all(|x| x.is_finite())
 }
 
 /// `sum_i c_i n_i (x) n_i` for the columns `n_i` of `n`.
