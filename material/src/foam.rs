@@ -25,8 +25,8 @@
 //! so the law reproduces its input curve exactly in incompressible uniaxial stress, and to
 //! `O(G/K)` for a finite bulk modulus. `f` and `df/dx` are tabulated once, at build time, on a
 //! uniform grid in `x = ln lb` over stretches 0.05 to 20 (4097 points) and evaluated by cubic
-//! Hermite interpolation (error ~1e-13 G for the default curve), with linear extrapolation in `x`
-//! beyond. The input curve is interpolated linearly in stretch and extrapolated linearly beyond
+//! Hermite interpolation (error ~1e-13 G for the default curve; each interval stores its cubic's
+//! four coefficients, evaluated by Horner's rule), with linear extrapolation in `x` beyond. The input curve is interpolated linearly in stretch and extrapolated linearly beyond
 //! its ends (as LS-DYNA load curves are); a point (1, 0) is inserted if absent, and the stress
 //! must increase strictly with stretch.
 //!
@@ -152,8 +152,11 @@ pub struct Foam {
     pub curve: UniaxialCurve,
     inv_h: f64,
     h: f64,
-    /// (f, h * df/dx) at the grid points.
-    table: Vec<[f64; 2]>,
+    /// Per grid interval `k`, the cubic Hermite interpolant `f = c0 + s (c1 + s (c2 + s c3))` in
+    /// the local coordinate `s = (x - x_k)/h` in [0, 1].
+    cubic: Vec<[f64; 4]>,
+    /// `(f, h df/dx)` at the first and the last grid point, for the linear extrapolation.
+    ends: [[f64; 2]; 2],
 }
 
 impl Foam {
@@ -203,6 +206,21 @@ impl Foam {
                 [f, df * h]
             })
             .collect();
+        // Hermite data (f_k, h f'_k), (f_k+1, h f'_k+1) on an interval give the cubic
+        // c0 = f_k, c1 = h f'_k, c2 = 3 (f_k+1 - f_k) - 2 h f'_k - h f'_k+1,
+        // c3 = 2 (f_k - f_k+1) + h f'_k + h f'_k+1.
+        let cubic = table
+            .windows(2)
+            .map(|w| {
+                let ([f0, d0], [f1, d1]) = (w[0], w[1]);
+                [
+                    f0,
+                    d0,
+                    3.0 * (f1 - f0) - 2.0 * d0 - d1,
+                    2.0 * (f0 - f1) + d0 + d1,
+                ]
+            })
+            .collect();
         let mut law = Foam {
             rho,
             bulk,
@@ -211,7 +229,8 @@ impl Foam {
             curve,
             inv_h: 1.0 / h,
             h,
-            table,
+            cubic,
+            ends: [table[0], table[N_GRID - 1]],
         };
         let g0 = 0.5 * law.f_and_slope(0.0).1;
         if !(g0 > 0.0) {
@@ -232,28 +251,19 @@ impl Foam {
         let t = (x - X_MIN) * self.inv_h;
         let n = N_GRID - 1;
         if t <= 0.0 {
-            let [f0, d0] = self.table[0];
+            let [f0, d0] = self.ends[0];
             return (f0 + d0 * t, d0 * self.inv_h);
         }
         if t >= n as f64 {
-            let [f1, d1] = self.table[n];
+            let [f1, d1] = self.ends[1];
             return (f1 + d1 * (t - n as f64), d1 * self.inv_h);
         }
-        let k = t as usize;
+        // 0 < t < n here: the u32 conversion is exact truncation.
+        let k = t as u32 as usize;
         let s = t - k as f64;
-        let [f0, d0] = self.table[k];
-        let [f1, d1] = self.table[k + 1];
-        // Cubic Hermite on [0, 1] with derivatives already scaled by h.
-        let s2 = s * s;
-        let s3 = s2 * s;
-        let h00 = 2.0 * s3 - 3.0 * s2 + 1.0;
-        let h10 = s3 - 2.0 * s2 + s;
-        let h01 = -2.0 * s3 + 3.0 * s2;
-        let h11 = s3 - s2;
-        let f = h00 * f0 + h10 * d0 + h01 * f1 + h11 * d1;
-        let df = (6.0 * s2 - 6.0 * s) * (f0 - f1)
-            + (3.0 * s2 - 4.0 * s + 1.0) * d0
-            + (3.0 * s2 - 2.0 * s) * d1;
+        let [c0, c1, c2, c3] = self.cubic[k];
+        let f = c0 + s * (c1 + s * (c2 + s * c3));
+        let df = c1 + s * (2.0 * c2 + 3.0 * s * c3);
         (f, df * self.inv_h)
     }
 

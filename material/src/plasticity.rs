@@ -48,9 +48,7 @@
 //! reports `failed` once `eps_p >= failure_strain`. Wave speed: `sqrt((K + 4/3 G) / rho)`.
 
 use crate::law::{checked_jacobian, Law, LawError, Mat3, Response};
-use crate::principal::{
-    all_finite6, b_minus_identity, mat_from_sym6, sandwich6, spectral6, sym_eigen, Sym6,
-};
+use crate::principal::{all_finite6, b_minus_identity, mat_from_sym6, sandwich6, Sym6, SymEigen};
 
 /// Piecewise-linear J2 plasticity.
 #[derive(Clone, Debug)]
@@ -238,7 +236,8 @@ impl Law for Plasticity {
                 a[k] += fq[k];
             }
         }
-        let (ev, n) = sym_eigen(&a);
+        let eig = SymEigen::of(&a);
+        let ev = eig.values;
         let mut eps = [0.0; 3];
         for i in 0..3 {
             if !(ev[i] > -1.0) {
@@ -281,8 +280,8 @@ impl Law for Plasticity {
             (f[(0, 1)] * f[(2, 0)] - f[(0, 0)] * f[(2, 1)]) * ij,
             (f[(0, 0)] * f[(1, 1)] - f[(0, 1)] * f[(1, 0)]) * ij,
         );
-        // S = F^-1 tau F^-T = sum_i tau_i (F^-1 n_i) (x) (F^-1 n_i).
-        let pk2 = spectral6(&tau, &(fi * n));
+        // S = F^-1 tau F^-T.
+        let pk2 = sandwich6(&fi, &eig.spectral6(&tau));
         if plastic {
             // C_p^-1 - I = F^-1 (b_e - b) F^-T, with b_e - b = (b_e - I) - (b - I): both
             // differences are accurate at small strain, and an elastic step would return Q.
@@ -291,7 +290,7 @@ impl Law for Plasticity {
                 (2.0 * (dev[1] + m)).exp_m1(),
                 (2.0 * (dev[2] + m)).exp_m1(),
             ];
-            let mut d = spectral6(&e2, &n);
+            let mut d = eig.spectral6(&e2);
             for k in 0..6 {
                 d[k] -= bm[k];
             }

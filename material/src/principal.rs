@@ -1,15 +1,18 @@
 //! Principal stretches and directions: the one eigen-kernel shared by every principal-stretch law
 //! (Ogden, simplified rubber/foam, Hencky plasticity).
 //!
-//! **Method.** [`sym_eigen`]: the isolated eigenvalue from the trigonometric (Cardano/Smith)
+//! **Method.** [`SymEigen`]: the isolated eigenvalue from the trigonometric (Cardano/Smith)
 //! solution, evaluated without trigonometric calls (a polynomial and one Newton step on the
-//! Chebyshev cubic), its eigenvector by cross products, and the remaining pair from the exact
-//! solution of the 2x2 projection on the orthogonal plane (see its doc). Plain Cardano for all
-//! three eigenvalues loses about half the digits of two eigenvalues that are 1e-8 apart; this
-//! hybrid does not, because the nearly equal pair comes from the 2x2 projection. It is
-//! non-iterative and calls no library function. A cyclic Jacobi solver
-//! ([`sym_eigen_jacobi`], Golub & Van Loan sec. 8.5, Numerical Recipes sec. 11.1) is kept as the
-//! reference it is tested against (and as the fallback for non-finite input).
+//! Chebyshev cubic), its eigenvector from the adjugate (cross products), and the remaining pair
+//! from the Frobenius norm of the deviatoric part of the tensor restricted to the orthogonal plane
+//! (see its doc). The laws only need isotropic functions `sum_i c_i N_i (x) N_i`, so the pair is
+//! kept as a projector difference and its eigenvectors are never formed; [`sym_eigen`] builds
+//! explicit eigenvectors (2x2 projection) for callers that need them. Plain Cardano for all three
+//! eigenvalues loses about half the digits of two eigenvalues that are 1e-8 apart; this hybrid
+//! does not, because the nearly equal pair comes from the projection on the plane. It is
+//! non-iterative and calls no library function. A cyclic Jacobi solver ([`sym_eigen_jacobi`],
+//! Golub & Van Loan sec. 8.5, Numerical Recipes sec. 11.1) is kept as the reference it is tested
+//! against (and as the fallback for non-finite input).
 //!
 //! **Shift.** The laws never decompose `C = F^T F` itself but `A = C - I = H + H^T + H^T H`
 //! (with `H = F - I`), and take `ln l_i = ln_1p(a_i) / 2`. The eigenvalues `a_i` then carry an
@@ -20,7 +23,8 @@
 //! the eigenspace. Every law here builds its stress as `sum_i c_i N_i (x) N_i` with a coefficient
 //! that is a function of the eigenvalue alone, so equal eigenvalues give equal coefficients and the
 //! sum is the same for every basis: the result is well defined and continuous, and no formula
-//! divides by a difference of stretches.
+//! divides a difference of coefficients by a difference of stretches ([`SymEigen::spectral6`]
+//! multiplies `c_1 - c_2` by a bounded tensor).
 //!
 //! Symmetric tensors are stored as `[xx, yy, zz, xy, yz, zx]` (the "Sym6" order used for
 //! history values and output columns).
@@ -204,54 +208,34 @@ fn cos_third_acos(r: f64) -> f64 {
     c - (c * (4.0 * c2 - 3.0) - r) / (12.0 * c2 - 3.0)
 }
 
-/// Eigenvalues and orthonormal eigenvectors (the columns of the returned matrix) of a symmetric
-/// tensor given as Sym6. Eigenvalues are not sorted.
-///
-/// Hybrid and non-iterative. With the deviator `B = A - tr(A)/3 I`, `p = sqrt(tr(B^2)/6)` and
-/// the scaled deviator `Bn = B / p` (eigenvalues in [-2, 2]):
-///
-/// 1. The trigonometric solution of the characteristic cubic (Smith 1961) gives the *isolated*
-///    eigenvalue of `Bn`, the one farthest from the other two: with `r = det(B) / (2 p^3)` in
-///    [-1, 1] it is `mu_0 = 2 sign(r) cos(acos(|r|)/3)` (the largest if det B >= 0, else the
-///    smallest). The formula is flat (`dc/dr = 1/9` at `|r| = 1`), hence accurate, exactly where
-///    the other two merge; `cos(acos(|r|)/3)` is evaluated without trigonometric calls
-///    ([`cos_third_acos`]).
-/// 2. Its eigenvector `v` is the largest cross product of two rows of `Bn - mu_0 I`. These
-///    cross products are the columns of `adj(Bn - mu_0 I) = (mu_1 - mu_0)(mu_2 - mu_0) v v^T`,
-///    and `|mu_i - mu_0| >= sqrt 3` for the isolated root, so the chosen one has
-///    `12 <= |v|^2 <= 81`: no scaling problem, and `v` is accurate to `eps |A| / spread`.
-/// 3. The other two come from the exact eigen-solution of the 2x2 projection of `Bn` on the
-///    plane orthogonal to `v`, spanned by `u = v x e` (`e` the coordinate axis least aligned
-///    with `v`, so `u` is a permutation of two components of `v`, exactly orthogonal to it) and
-///    `w = v x u`. Neither is normalised first: with `n_v = |v|^2`, `n_u = |u|^2` and
-///    `|w| = sqrt(n_v n_u)`, the projection times `n_v n_u` is
-///    `K = [[n_v u.Bn u, sqrt(n_v) u.Bn w], [sqrt(n_v) u.Bn w, w.Bn w]]`, whose eigenvalues,
-///    with `d = (K11 - K22)/2` and `h = sqrt(d^2 + K12^2)`, are `(K11 + K22)/2 +- h`; the
-///    eigenvector of the larger one is `(h + d, K12)` if `d >= 0`, else `(K12, h - d)`, in the
-///    orthonormal coordinates `(u/|u|, w/|w|)` (the two rows of `K - l I`, whichever has no
-///    cancellation). Neither form subtracts nearly equal numbers, so the pair is stable for
-///    equal and nearly equal eigenvalues (an exactly degenerate pair keeps `(u, w)`).
-///
-/// Eigenvalues of `A` are `tr(A)/3 + p mu`, the isolated one from the Rayleigh quotient
-/// `v.Bn v / n_v`. An error in the directions only enters a principal-stretch stress multiplied
-/// by a difference of principal stresses, itself proportional to the spread, so stresses stay
-/// accurate to round-off of `|A|` (tested against [`sym_eigen_jacobi`] over 2000 random,
-/// degenerate and nearly degenerate matrices).
-///
-/// Cost: five square roots, four divisions, no library call and no iteration. The normalising
-/// factors are computed from `n_v` and `n_u` alongside the quadratic forms, so the only long
-/// operations on the path to the eigenvalues are `sqrt(p^2)`, `1/p^2`, the Newton division and
-/// `sqrt(d^2 + K12^2)`.
+/// First stage shared by [`SymEigen::of`] and [`sym_eigen`]: the isolated eigenvalue and its
+/// eigenvector (see [`SymEigen`] for the method).
+enum Isolated {
+    /// `tr(B^2)/6 <= 1e-280`: isotropic to round-off (or below underflow).
+    Isotropic,
+    /// Non-finite input (the eigenvector bound failed).
+    NonFinite,
+    /// `A = mean I + p Bn`; `mu0` is the isolated eigenvalue of `Bn`, `v` (with `nv = |v|^2`,
+    /// `12 <= nv <= 81`) an unnormalised eigenvector of it.
+    Found {
+        mean: f64,
+        p: f64,
+        bn: Sym6,
+        mu0: f64,
+        v: [f64; 3],
+        nv: f64,
+    },
+}
+
 #[inline(always)]
-pub fn sym_eigen(m: &Sym6) -> ([f64; 3], Mat3) {
+fn isolated(m: &Sym6) -> Isolated {
     let mean = (m[0] + m[1] + m[2]) * (1.0 / 3.0);
     let b = [m[0] - mean, m[1] - mean, m[2] - mean, m[3], m[4], m[5]];
     let p2 =
         (b[0] * b[0] + b[1] * b[1] + b[2] * b[2] + 2.0 * (b[3] * b[3] + b[4] * b[4] + b[5] * b[5]))
             * (1.0 / 6.0);
     if !(p2 > 1e-280) {
-        // Isotropic to round-off (or below underflow): any basis.
-        return ([m[0], m[1], m[2]], Mat3::identity());
+        return Isolated::Isotropic;
     }
     let p = p2.sqrt();
     let ip2 = 1.0 / p2;
@@ -260,7 +244,7 @@ pub fn sym_eigen(m: &Sym6) -> ([f64; 3], Mat3) {
         + b[5] * (b[3] * b[4] - b[1] * b[5]);
     let r = (0.5 * det.abs() * (ip2 * ip)).min(1.0);
     let c2 = 2.0 * cos_third_acos(r);
-    let mu_iso = if det >= 0.0 { c2 } else { -c2 };
+    let mu0 = if det >= 0.0 { c2 } else { -c2 };
     let bn = [
         b[0] * ip,
         b[1] * ip,
@@ -269,22 +253,210 @@ pub fn sym_eigen(m: &Sym6) -> ([f64; 3], Mat3) {
         b[4] * ip,
         b[5] * ip,
     ];
-    let r0 = [bn[0] - mu_iso, bn[3], bn[5]];
-    let r1 = [bn[3], bn[1] - mu_iso, bn[4]];
-    let r2 = [bn[5], bn[4], bn[2] - mu_iso];
-    let (c01, c02, c12) = (cross(r0, r1), cross(r0, r2), cross(r1, r2));
-    let (n01, n02, n12) = (dot(c01, c01), dot(c02, c02), dot(c12, c12));
-    let (v, nv) = if n01 >= n02 && n01 >= n12 {
-        (c01, n01)
-    } else if n02 >= n12 {
-        (c02, n02)
+    // N = Bn - mu0 I; adj(N) = (mu1 - mu0)(mu2 - mu0) v v^T, a non-negative multiple of the
+    // projector. Its largest diagonal entry (a 2x2 principal minor of N) marks the largest
+    // column, which is the cross product of the other two rows.
+    let (n0, n1, n2) = (bn[0] - mu0, bn[1] - mu0, bn[2] - mu0);
+    let r0 = [n0, bn[3], bn[5]];
+    let r1 = [bn[3], n1, bn[4]];
+    let r2 = [bn[5], bn[4], n2];
+    let m0 = n1 * n2 - bn[4] * bn[4];
+    let m1 = n0 * n2 - bn[5] * bn[5];
+    let m2 = n0 * n1 - bn[3] * bn[3];
+    let v = if m0 >= m1 && m0 >= m2 {
+        cross(r1, r2)
+    } else if m1 >= m2 {
+        cross(r2, r0)
     } else {
-        (c12, n12)
+        cross(r0, r1)
     };
+    let nv = dot(v, v);
     if !(nv > 1.0 && nv < 1e3) {
         // 12 <= nv <= 81 in exact arithmetic: only a non-finite input gets here.
-        return sym_eigen_jacobi(m);
+        return Isolated::NonFinite;
     }
+    Isolated::Found {
+        mean,
+        p,
+        bn,
+        mu0,
+        v,
+        nv,
+    }
+}
+
+/// Spectral decomposition of a symmetric 3x3 tensor `A`, in the form an isotropic tensor function
+/// `sum_i c_i N_i (x) N_i` needs: the eigenvalues, the projector `V = N_0 (x) N_0` on the isolated
+/// eigenvector and the half-difference `D = (N_1 (x) N_1 - N_2 (x) N_2) / 2` of the projectors
+/// of the other two, so that (with `I = V + N_1 (x) N_1 + N_2 (x) N_2`)
+///
+/// ```text
+/// sum_i c_i N_i (x) N_i = cm I + (c_0 - cm) V + (c_1 - c_2) D,      cm = (c_1 + c_2)/2
+/// ```
+///
+/// ([`SymEigen::spectral6`]). The eigenvectors of the pair are never formed.
+///
+/// **Method.** Non-iterative, no library call. With the deviator `B = A - tr(A)/3 I`,
+/// `p = sqrt(tr(B^2)/6)` and the scaled deviator `Bn = B / p` (eigenvalues in [-2, 2]):
+///
+/// 1. The trigonometric solution of the characteristic cubic (Smith 1961) gives the *isolated*
+///    eigenvalue of `Bn`, the one farthest from the other two: with `r = det(B) / (2 p^3)` in
+///    [-1, 1] it is `mu_0 = 2 sign(r) cos(acos(|r|)/3)` (the largest if det B >= 0, else the
+///    smallest). The formula is flat (`dc/dr = 1/9` at `|r| = 1`), hence accurate, exactly where
+///    the other two merge; `cos(acos(|r|)/3)` is evaluated without trigonometric calls
+///    (`cos_third_acos`, a polynomial and one Newton step).
+/// 2. Its eigenvector: `adj(Bn - mu_0 I) = (mu_1 - mu_0)(mu_2 - mu_0) N_0 (x) N_0` and
+///    `|mu_i - mu_0| >= sqrt 3` for the isolated root, so the column of the adjugate with the
+///    largest diagonal entry (a 2x2 principal minor), i.e. the cross product of the other two
+///    rows, is `v` with `12 <= |v|^2 <= 81`: accurate to `eps / spread`, and
+///    `V = v v^T / |v|^2` needs no square root.
+/// 3. The pair: `Q = Bn - m I - (mu_0 - m) V` with `m = (tr Bn - mu_0)/2` the mean of the pair is
+///    `Bn` restricted to the plane orthogonal to `N_0`, minus its mean there:
+///    `Q = h (N_1 (x) N_1 - N_2 (x) N_2)` with `h = (mu_1 - mu_2)/2 = |Q|_F / sqrt 2`. So the pair
+///    is `m +- h` and `D = Q / (2h)`. `Q` is formed from entries of size 1, so `h` carries an
+///    absolute error of a few `eps` however close the pair is, and nothing subtracts two nearly
+///    equal squares (the invariant form `(mu_1 - mu_2)^2 = 12 - 3 mu_0^2` loses half the
+///    digits). When the pair is (nearly) equal, `D` is dominated by rounding, but it only enters
+///    the function multiplied by `c_1 - c_2 ~ c'(m) 2h`, so the result keeps an absolute error
+///    `~ eps (|c| + |c'|)`: isotropic functions are continuous through degeneracy and no formula
+///    divides a difference of `c` by a difference of eigenvalues. `Q = 0` exactly gives `D = 0`.
+///
+/// Eigenvalues of `A` are `tr(A)/3 + p mu`. Tested against [`sym_eigen_jacobi`] over 2000
+/// random, degenerate and nearly degenerate matrices, and for reconstruction
+/// (`sum lambda_i N_i (x) N_i = A`) and the projector identities.
+#[derive(Clone, Copy, Debug)]
+pub struct SymEigen {
+    /// Eigenvalues: the isolated one, then the larger and the smaller of the pair.
+    pub values: [f64; 3],
+    /// `V = N_0 (x) N_0`, as Sym6.
+    pub proj: Sym6,
+    /// `D = (N_1 (x) N_1 - N_2 (x) N_2) / 2`, as Sym6.
+    pub half_diff: Sym6,
+}
+
+impl SymEigen {
+    /// Decompose a symmetric tensor given as Sym6.
+    #[inline(always)]
+    pub fn of(m: &Sym6) -> SymEigen {
+        let (mean, p, bn, mu0, v, nv) = match isolated(m) {
+            Isolated::Found {
+                mean,
+                p,
+                bn,
+                mu0,
+                v,
+                nv,
+            } => (mean, p, bn, mu0, v, nv),
+            Isolated::Isotropic => {
+                // Any basis: the coordinate axes.
+                return SymEigen {
+                    values: [m[0], m[1], m[2]],
+                    proj: [1.0, 0.0, 0.0, 0.0, 0.0, 0.0],
+                    half_diff: [0.0, 0.5, -0.5, 0.0, 0.0, 0.0],
+                };
+            }
+            Isolated::NonFinite => {
+                let (l, n) = sym_eigen_jacobi(m);
+                return SymEigen::from_vectors(l, &n);
+            }
+        };
+        let inv_nv = 1.0 / nv;
+        let mid = 0.5 * ((bn[0] + bn[1] + bn[2]) - mu0);
+        let k = (mu0 - mid) * inv_nv;
+        let q = [
+            bn[0] - mid - k * v[0] * v[0],
+            bn[1] - mid - k * v[1] * v[1],
+            bn[2] - mid - k * v[2] * v[2],
+            bn[3] - k * v[0] * v[1],
+            bn[4] - k * v[1] * v[2],
+            bn[5] - k * v[2] * v[0],
+        ];
+        let h2 = 0.5 * ddot6(&q, &q);
+        let h = h2.sqrt();
+        let g = if h2 > 0.0 { 0.5 / h } else { 0.0 };
+        SymEigen {
+            values: [mean + p * mu0, mean + p * (mid + h), mean + p * (mid - h)],
+            proj: [
+                v[0] * v[0] * inv_nv,
+                v[1] * v[1] * inv_nv,
+                v[2] * v[2] * inv_nv,
+                v[0] * v[1] * inv_nv,
+                v[1] * v[2] * inv_nv,
+                v[2] * v[0] * inv_nv,
+            ],
+            half_diff: [q[0] * g, q[1] * g, q[2] * g, q[3] * g, q[4] * g, q[5] * g],
+        }
+    }
+
+    /// From eigenvalues and orthonormal eigenvectors (the columns of `n`).
+    pub fn from_vectors(values: [f64; 3], n: &Mat3) -> SymEigen {
+        let outer = |k: usize| {
+            spectral6(
+                &[
+                    (k == 0) as u8 as f64,
+                    (k == 1) as u8 as f64,
+                    (k == 2) as u8 as f64,
+                ],
+                n,
+            )
+        };
+        let (v, x, y) = (outer(0), outer(1), outer(2));
+        let mut d = [0.0; 6];
+        for k in 0..6 {
+            d[k] = 0.5 * (x[k] - y[k]);
+        }
+        SymEigen {
+            values,
+            proj: v,
+            half_diff: d,
+        }
+    }
+
+    /// `sum_i c_i N_i (x) N_i`, as Sym6.
+    #[inline(always)]
+    pub fn spectral6(&self, c: &[f64; 3]) -> Sym6 {
+        let cm = 0.5 * (c[1] + c[2]);
+        let a = c[0] - cm;
+        let g = c[1] - c[2];
+        let (v, d) = (&self.proj, &self.half_diff);
+        [
+            cm + a * v[0] + g * d[0],
+            cm + a * v[1] + g * d[1],
+            cm + a * v[2] + g * d[2],
+            a * v[3] + g * d[3],
+            a * v[4] + g * d[4],
+            a * v[5] + g * d[5],
+        ]
+    }
+}
+
+/// Eigenvalues and orthonormal eigenvectors (the columns of the returned matrix) of a symmetric
+/// tensor given as Sym6. Eigenvalues are not sorted. The laws use [`SymEigen`], which does not
+/// form the eigenvectors of the pair; this is for callers that need the vectors themselves.
+///
+/// Steps 1 and 2 are those of [`SymEigen`]. The pair comes from the exact eigen-solution of the
+/// 2x2 projection of `Bn` on the plane orthogonal to `v`, spanned by `u = v x e` (`e` the
+/// coordinate axis least aligned with `v`, so `u` is a permutation of two components of `v`,
+/// exactly orthogonal to it) and `w = v x u`. Neither is normalised first: with `n_v = |v|^2`,
+/// `n_u = |u|^2` and `|w| = sqrt(n_v n_u)`, the projection times `n_v n_u` is
+/// `K = [[n_v u.Bn u, sqrt(n_v) u.Bn w], [sqrt(n_v) u.Bn w, w.Bn w]]`, whose eigenvalues, with
+/// `d = (K11 - K22)/2` and `h = sqrt(d^2 + K12^2)`, are `(K11 + K22)/2 +- h`; the eigenvector of
+/// the larger one is `(h + d, K12)` if `d >= 0`, else `(K12, h - d)`, in the orthonormal
+/// coordinates `(u/|u|, w/|w|)` (the two rows of `K - l I`, whichever has no cancellation).
+/// Neither form subtracts nearly equal numbers, so the pair is stable for equal and nearly equal
+/// eigenvalues (an exactly degenerate pair keeps `(u, w)`). The isolated eigenvalue is the
+/// Rayleigh quotient `v.Bn v / n_v`. An error in the directions only enters a principal-stretch
+/// stress multiplied by a difference of principal stresses, itself proportional to the spread, so
+/// stresses stay accurate to round-off of `|A|` (tested against [`sym_eigen_jacobi`]).
+#[inline]
+pub fn sym_eigen(m: &Sym6) -> ([f64; 3], Mat3) {
+    let (mean, p, bn, v, nv) = match isolated(m) {
+        Isolated::Found {
+            mean, p, bn, v, nv, ..
+        } => (mean, p, bn, v, nv),
+        Isolated::Isotropic => return ([m[0], m[1], m[2]], Mat3::identity()),
+        Isolated::NonFinite => return sym_eigen_jacobi(m),
+    };
     let (ax, ay, az) = (v[0].abs(), v[1].abs(), v[2].abs());
     let u = if ax <= ay && ax <= az {
         [0.0, v[2], -v[1]]
@@ -367,8 +539,9 @@ pub struct Principal {
     pub ln_stretch: [f64; 3],
     /// `ln J = sum_i ln l_i`.
     pub ln_j: f64,
-    /// Reference (Lagrangian) principal directions `N_i`, as columns: eigenvectors of `C`.
-    pub directions: Mat3,
+    /// Spectral decomposition of `C - I` (eigenvalues `l_i^2 - 1`): the reference (Lagrangian)
+    /// principal directions `N_i`, as the projectors that stresses `sum_i c_i N_i (x) N_i` need.
+    pub eigen: SymEigen,
     /// `l_i^2`, the eigenvalues of `C`.
     pub stretch_sq: [f64; 3],
     /// `1 / l_i^2`, the eigenvalues of `C^-1`.
@@ -382,7 +555,8 @@ impl Principal {
     #[inline(always)]
     pub fn of(f: &Mat3) -> Result<Principal, LawError> {
         let c1 = c_minus_identity(f);
-        let (a, n) = sym_eigen(&c1);
+        let eigen = SymEigen::of(&c1);
+        let a = eigen.values;
         let mut ln = [0.0; 3];
         let mut sq = [0.0; 3];
         let mut inv = [0.0; 3];
@@ -398,7 +572,7 @@ impl Principal {
         Ok(Principal {
             ln_stretch: ln,
             ln_j: ln[0] + ln[1] + ln[2],
-            directions: n,
+            eigen,
             stretch_sq: sq,
             inv_stretch_sq: inv,
             c_minus_i: c1,
@@ -425,7 +599,7 @@ impl Principal {
             tau[1] * self.inv_stretch_sq[1],
             tau[2] * self.inv_stretch_sq[2],
         ];
-        spectral6(&c, &self.directions)
+        self.eigen.spectral6(&c)
     }
 }
 
@@ -478,6 +652,38 @@ mod tests {
     fn check(m: Sym6) {
         check_with(m, sym_eigen);
         check_with(m, sym_eigen_jacobi);
+        check_projectors(m);
+    }
+
+    /// `SymEigen`: reconstruction, partition of unity, and (for a separated pair) the projector
+    /// identities `V^2 = V`, `tr V = 1`, `V D = 0`, `(2D)^2 = I - V`.
+    fn check_projectors(m: Sym6) {
+        let e = SymEigen::of(&m);
+        let a = mat_from_sym6(&m);
+        let scale = a.norm().max(1e-300);
+        let recon = mat_from_sym6(&e.spectral6(&e.values));
+        assert!(
+            (recon - a).norm() <= 4e-16 * scale * 16.0,
+            "{:e}",
+            (recon - a).norm() / scale
+        );
+        assert_eq!(mat_from_sym6(&e.spectral6(&[1.0; 3])), Mat3::identity());
+        let (v, d) = (mat_from_sym6(&e.proj), mat_from_sym6(&e.half_diff));
+        assert!((v * v - v).norm() < 1e-14 && (v.trace() - 1.0).abs() < 1e-14);
+        let spread = (e.values[1] - e.values[2]).abs();
+        if spread > 1e-6 * scale {
+            assert!(
+                (v * d).norm() < 1e-14 * scale / spread,
+                "{:e}",
+                (v * d).norm()
+            );
+            let d2 = 4.0 * d * d;
+            assert!(
+                (d2 - (Mat3::identity() - v)).norm() < 1e-14 * scale / spread,
+                "{:e}",
+                (d2 - (Mat3::identity() - v)).norm()
+            );
+        }
     }
 
     fn check_with(m: Sym6, eig: fn(&Sym6) -> ([f64; 3], Mat3)) {
@@ -551,6 +757,14 @@ mod tests {
                 "k={k} d={d:?}: {:e}",
                 (f1 - f2).norm()
             );
+            let e = SymEigen::of(&a);
+            let f3 = mat_from_sym6(&e.spectral6(&e.values.map(g)));
+            assert!(
+                (f3 - f2).norm() < 1e-13 * f2.norm(),
+                "k={k} d={d:?}: {:e}",
+                (f3 - f2).norm()
+            );
+            check_projectors(a);
         }
     }
 
