@@ -29,8 +29,9 @@
 //! piecewise-linear hardening curve the scalar equation is solved exactly, segment by segment, so
 //! the return is exact for linear (and piecewise-linear) hardening. Then
 //! `b_e = sum exp(2 eps_e,i) n_i (x) n_i`, `C_p^-1 = F^-1 b_e F^-T`, `S = F^-1 tau F^-T`.
-//! Computed as `S = sum_i tau_i m_i (x) m_i` with `m_i = F^-1 n_i` (`F^-1` from the cofactors and
-//! `J`), and, after a plastic step only, `C_p^-1 - I = F^-1 (b_e - b) F^-T` with
+//! `tau` and `b_e` are assembled from the projector form of the eigen-solution
+//! ([`crate::principal::SymEigen`]), `F^-1` from the cofactors and `J`; after a plastic step
+//! only, `C_p^-1 - I = F^-1 (b_e - b) F^-T` with
 //! `b_e - b = sum_i expm1(2 eps_e,i) n_i (x) n_i - (b - I)`, a difference of two accurate
 //! differences. The elastic test compares `q_tr^2` with `sigma_y^2`, so an elastic step takes no
 //! square root and leaves the history untouched.
@@ -249,12 +250,13 @@ impl Law for Plasticity {
         let m = ev_vol / 3.0;
         let mut dev = [eps[0] - m, eps[1] - m, eps[2] - m];
         let g2 = 2.0 * self.shear;
-        // q_tr^2 = 3/2 |2 G dev eps|^2, compared squared: no square root on the elastic path.
+        // q_tr^2 = 3/2 |2 G dev eps|^2, compared squared: no square root on the elastic path
+        // (q_tr > sy, also for a curve softened below zero).
         let q_tr2 = 1.5 * g2 * g2 * (dev[0] * dev[0] + dev[1] * dev[1] + dev[2] * dev[2]);
         let sy = self.yield_stress(ep);
         let mut dissipation = 0.0;
         let mut ep_new = ep;
-        let plastic = q_tr2 > sy * sy;
+        let plastic = q_tr2 > sy * sy || sy < 0.0;
         if plastic {
             let q_tr = q_tr2.sqrt();
             let dg = self.return_map(q_tr, ep, sy);
