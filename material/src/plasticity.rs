@@ -247,7 +247,7 @@ impl Law for Plasticity {
             eps[i] = 0.5 * ev[i].ln_1p();
         }
         let ev_vol = eps[0] + eps[1] + eps[2];
-        let m = ev_vol / 3.0;
+        let m = ev_vol * (1.0 / 3.0);
         let mut dev = [eps[0] - m, eps[1] - m, eps[2] - m];
         let g2 = 2.0 * self.shear;
         // q_tr^2 = 3/2 |2 G dev eps|^2, compared squared: no square root on the elastic path

@@ -601,7 +601,7 @@ impl Principal {
     /// Isochoric logarithmic stretches `ln lbar_i = ln l_i - ln J / 3`.
     #[inline(always)]
     pub fn ln_isochoric(&self) -> [f64; 3] {
-        let s = self.ln_j / 3.0;
+        let s = self.ln_j * (1.0 / 3.0);
         [
             self.ln_stretch[0] - s,
             self.ln_stretch[1] - s,
