@@ -74,6 +74,7 @@ pub fn element_loop(
         let gslots = &mut slots[g.slot_offset..g.slot_offset + n];
         let (elements, conn, grad, vol0) = (&g.elements, &g.conn, &g.grad, &g.vol0);
         let eroded = &g.eroded;
+        let dt_floor = g.dt_floor;
         let (gamma, hgk, gpg, gpw, dscale) = (
             &g.gamma,
             &g.hg_scale,
@@ -127,7 +128,13 @@ pub fn element_loop(
                         }
                     };
                     match r {
-                        Ok(o) => {
+                        Ok(mut o) => {
+                            if o.dt < dt_floor {
+                                // Run-time mass scaling: dt grows with sqrt(density scale).
+                                let r = dt_floor / o.dt;
+                                acc.rescale.push((le as u32, s * r * r));
+                                o.dt = dt_floor;
+                            }
                             if o.dt < acc.dt_min {
                                 acc.dt_min = o.dt;
                                 acc.dt_elem = elements[le];

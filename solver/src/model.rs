@@ -116,6 +116,9 @@ pub struct ChunkOut {
     pub error: Option<(u32, String)>,
     /// Elements (group-local index) that reached their law's failure criterion this step.
     pub failed: Vec<u32>,
+    /// Run-time mass scaling: elements (group-local index) whose step fell below the group's
+    /// floor this step, with the density scale that brings it back to the floor.
+    pub rescale: Vec<(u32, f64)>,
 }
 
 /// A group of elements with one law and one formulation (struct of arrays).
@@ -157,6 +160,13 @@ pub struct Group {
     /// [`crate::element::surface_mode_factor`]); the element loop multiplies the group's
     /// smallest `L / c` by it.
     pub dt_kappa: f64,
+    /// Run-time mass scaling: the smallest `L / c` an element may have,
+    /// `target_dt / (dt_factor * dt_kappa)` (0 without mass scaling).
+    pub dt_floor: f64,
+    /// Lumped volume of each element node (m^3), kept only with mass scaling (to add mass).
+    pub lumped: Vec<[f64; 8]>,
+    /// Reference density of the part's law (kg/m^3).
+    pub rho: f64,
 }
 
 /// Elements per parallel chunk. Fixed, so partial sums are formed in the same order for any
@@ -211,6 +221,11 @@ pub struct Model {
     pub initial_dt: (f64, u32),
     /// Initial critical step with mass scaling (s).
     pub scaled_dt: f64,
+    /// Selective mass scaling, if requested: applied at build time to the elements whose
+    /// initial step is below the target, and again during the run to every element whose
+    /// step falls below it (LS-DYNA's negative DT2MS), see
+    /// [`crate::simulation::Simulation`].
+    pub mass_scaling: Option<MassScaling>,
 }
 
 /// Initial critical step of one element (s): L / c with L = V / A_max.
@@ -283,10 +298,16 @@ impl Model {
                 chunks: vec![ChunkOut::default(); n.div_ceil(CHUNK)],
                 eroded: Vec::new(),
                 dt_kappa: 1.0,
+                dt_floor: 0.0,
+                lumped: Vec::new(),
+                rho,
             };
             let mut scale = Vec::with_capacity(n);
             let lambda2mu = rho * c0 * c0;
             g.dt_kappa = surface_mode_factor(lambda2mu, law.initial_shear_modulus());
+            if let Some(ms) = mass_scaling {
+                g.dt_floor = ms.target_dt / (dt_factor * g.dt_kappa);
+            }
             // Hourglass scaling of the part (see `HourglassModulus`): the stiffness form's
             // modulus, and the factor on c of the viscous form.
             let (hg_modulus, hg_c_ratio) = match form {
@@ -353,6 +374,9 @@ impl Model {
                 }
                 scaled_dt = scaled_dt.min(dte * s.sqrt());
                 scale.push(s);
+                if mass_scaling.is_some() {
+                    g.lumped.push(geo.lumped_volume);
+                }
                 part_mass[pi].physical += rho * geo.volume;
                 part_mass[pi].added += rho * geo.volume * (s - 1.0);
                 part_mass[pi].elements += 1;
@@ -430,6 +454,7 @@ impl Model {
             n_slots: slot_offset,
             initial_dt,
             scaled_dt,
+            mass_scaling,
         })
     }
 
