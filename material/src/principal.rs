@@ -323,7 +323,8 @@ fn isolated(m: &Sym6) -> Isolated {
 /// 2. Its eigenvector: `adj(Bn - mu_0 I) = (mu_1 - mu_0)(mu_2 - mu_0) N_0 (x) N_0` and
 ///    `|mu_i - mu_0| >= sqrt 3` for the isolated root, so the column of the adjugate with the
 ///    largest diagonal entry (a 2x2 principal minor), i.e. the cross product of the other two
-///    rows, is `v` with `12 <= |v|^2 <= 81`: accurate to `eps / spread`, and
+///    rows (as in Kopp 2008, Int. J. Mod. Phys. C 19:523), is `v` with `12 <= |v|^2 <= 81`:
+///    accurate to `eps / spread`, and
 ///    `V = v v^T / |v|^2` needs no square root.
 /// 3. The pair: `Q = Bn - m I - (mu_0 - m) V` with `m = (tr Bn - mu_0)/2` the mean of the pair
 ///    (formed as `|v|^2 Q`, so that the division by `|v|^2` runs beside it) is
@@ -332,8 +333,9 @@ fn isolated(m: &Sym6) -> Isolated {
 ///    is `m +- h` and `D = Q / (2h)`. `Q` is formed from entries of size 1, so `h` carries an
 ///    absolute error of a few `eps` however close the pair is, and nothing subtracts two nearly
 ///    equal squares (the invariant form `(mu_1 - mu_2)^2 = 12 - 3 mu_0^2` loses half the
-///    digits). When the pair is (nearly) equal, `D` is dominated by rounding, but it only enters
-///    the function multiplied by `c_1 - c_2 ~ c'(m) 2h`, so the result keeps an absolute error
+///    digits). When the pair is (nearly) equal, `D` is dominated by rounding, but its norm is
+///    `1/sqrt 2` by construction (`h` comes from the same `Q`) and it only enters the function
+///    multiplied by `c_1 - c_2 ~ c'(m) 2h`, so the result keeps an absolute error
 ///    `~ eps (|c| + |c'|)`: isotropic functions are continuous through degeneracy and no formula
 ///    divides a difference of `c` by a difference of eigenvalues. `Q = 0` exactly gives `D = 0`.
 ///
