@@ -48,7 +48,7 @@
 //! [solver]
 //! element = "one_point"            # one_point | stiffness | full_fbar
 //! dt_factor = 0.9
-//! # mass_scaling = "4 us"          # selective mass scaling target step (off by default)
+//! mass_scaling = "initial"         # selective mass scaling: initial (default) | "2 x initial" | "4 us" | "off"
 //! # mass_scaling_limit = 0.05
 //! vtk = false                      # VTK frames of every run (off: only the probe files)
 //! ```
@@ -219,8 +219,9 @@ pub struct SolverSpec {
     pub element: Option<String>,
     /// Time-step safety factor (default 0.75).
     pub dt_factor: Option<Number>,
-    /// Selective mass scaling to this step (off by default).
-    pub mass_scaling: Option<Time>,
+    /// Selective mass scaling: `"initial"` (the default, as `palpa palpate`), `"<k> x
+    /// initial"`, a time step, or `"off"`.
+    pub mass_scaling: Option<String>,
     /// Largest added mass fraction (default 0.05).
     pub mass_scaling_limit: Option<Number>,
     /// Write VTK frames of every run (default false).
@@ -448,7 +449,15 @@ impl CampaignSpec {
         if let Some(f) = sv.dt_factor {
             base.dt_factor = f.0;
         }
-        base.mass_scaling_dt = sv.mass_scaling.map(|t| t.0);
+        if let Some(m) = &sv.mass_scaling {
+            base.mass_scaling = match m.trim() {
+                "off" | "none" => None,
+                t => Some(
+                    crate::model::StepTarget::parse(t)
+                        .map_err(|e| format!("solver.mass_scaling: {e}"))?,
+                ),
+            };
+        }
         if let Some(l) = sv.mass_scaling_limit {
             base.mass_scaling_limit = l.0;
         }
@@ -659,7 +668,7 @@ impl Campaign {
                 "finger_spacing_m": b.finger_spacing,
                 "element": b.element.label(),
                 "dt_factor": b.dt_factor,
-                "mass_scaling_dt_s": b.mass_scaling_dt,
+                "mass_scaling": b.mass_scaling.map(|t| t.to_string()),
                 "mass_scaling_limit": b.mass_scaling_limit,
                 "vtk": b.vtk,
             },

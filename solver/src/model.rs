@@ -176,6 +176,68 @@ pub const CHUNK: usize = 512;
 /// Mass-scaling request.
 #[derive(Clone, Copy, Debug)]
 pub struct MassScaling {
+    /// Target time step.
+    pub target: StepTarget,
+    /// Largest allowed added mass as a fraction of physical mass.
+    pub max_added: f64,
+}
+
+/// The target step of mass scaling.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum StepTarget {
+    /// A step (s).
+    Step(f64),
+    /// A multiple of the model's initial stable step `dt_factor * min_e kappa L_e / c_e`
+    /// (scene: `"initial"` for 1, `"4 x initial"`). With 1, no element gets mass at the start,
+    /// and an element gets mass only once it shrinks during the run: the step never falls
+    /// below its initial value (LS-DYNA's DT2MS = -TSSFAC * dt_initial).
+    Initial(f64),
+}
+
+impl StepTarget {
+    /// Parse `"initial"`, `"<k> x initial"` or a time with its unit (`"2 us"`; a plain number
+    /// is seconds).
+    pub fn parse(s: &str) -> Result<StepTarget, String> {
+        let t = s.trim();
+        if let Some(k) = t.strip_suffix("initial") {
+            let k = k.trim();
+            let k = if k.is_empty() {
+                1.0
+            } else {
+                let num = k
+                    .strip_suffix(['x', '*'])
+                    .ok_or_else(|| format!("`{s}`: expected \"initial\" or \"<k> x initial\""))?;
+                num.trim()
+                    .parse::<f64>()
+                    .map_err(|_| format!("`{s}`: expected \"<k> x initial\" with a number k"))?
+            };
+            if !(k > 0.0 && k.is_finite()) {
+                return Err(format!("`{s}`: the multiple must be positive"));
+            }
+            return Ok(StepTarget::Initial(k));
+        }
+        let q = material::quantity::Quantity::parse(t)?;
+        let v = q.get(material::quantity::Dim::TIME)?;
+        if !(v > 0.0 && v.is_finite()) {
+            return Err(format!("`{s}`: the target step must be positive"));
+        }
+        Ok(StepTarget::Step(v))
+    }
+}
+
+impl fmt::Display for StepTarget {
+    fn fmt(&self, f: &mut fmt::Formatter) -> fmt::Result {
+        match self {
+            StepTarget::Step(t) => write!(f, "{t} s"),
+            StepTarget::Initial(k) if *k == 1.0 => f.write_str("initial"),
+            StepTarget::Initial(k) => write!(f, "{k} x initial"),
+        }
+    }
+}
+
+/// Mass scaling as the model applies it: the target resolved to a step.
+#[derive(Clone, Copy, Debug)]
+pub struct ResolvedMassScaling {
     /// Target time step (s).
     pub target_dt: f64,
     /// Largest allowed added mass as a fraction of physical mass.
@@ -225,13 +287,40 @@ pub struct Model {
     /// initial step is below the target, and again during the run to every element whose
     /// step falls below it (LS-DYNA's negative DT2MS), see
     /// [`crate::simulation::Simulation`].
-    pub mass_scaling: Option<MassScaling>,
+    pub mass_scaling: Option<ResolvedMassScaling>,
 }
 
 /// Initial critical step of one element (s): L / c with L = V / A_max.
 pub fn initial_element_dt(x: &[[f64; 3]; 8], volume: f64, c: f64) -> f64 {
     let xt = std::array::from_fn(|i| std::array::from_fn(|a| x[a][i]));
     volume / max_face_area(&xt) / c
+}
+
+/// Smallest initial `kappa L / c` over the mesh (s), without mass scaling. Inverted elements
+/// are skipped here (the model build reports them).
+fn natural_step(mesh: &Mesh, parts: &[Part]) -> f64 {
+    let props: Vec<(f64, f64)> = parts
+        .iter()
+        .map(|p| {
+            let c0 = p.material.initial_wave_speed();
+            let m = p.material.density() * c0 * c0;
+            (
+                c0,
+                surface_mode_factor(m, p.material.initial_shear_modulus()),
+            )
+        })
+        .collect();
+    let mut dt = f64::INFINITY;
+    for (e, conn) in mesh.elements.iter().enumerate() {
+        let x: [[f64; 3]; 8] = std::array::from_fn(|a| mesh.nodes[conn[a] as usize]);
+        if let (Ok(geo), Some(&(c0, kappa))) = (
+            element_geometry(&x),
+            props.get(mesh.element_part[e] as usize),
+        ) {
+            dt = dt.min(kappa * initial_element_dt(&x, geo.volume, c0));
+        }
+    }
+    dt
 }
 
 impl Model {
@@ -266,6 +355,12 @@ impl Model {
             .collect();
         let mut slot_offset = 0;
         let mut initial_dt = (f64::INFINITY, 0u32);
+        // The target step; a multiple of the initial step needs that step first.
+        let fixed_target = match mass_scaling.map(|m| m.target) {
+            None => None,
+            Some(StepTarget::Step(t)) => Some(t),
+            Some(StepTarget::Initial(k)) => Some(k * dt_factor * natural_step(&mesh, &parts)),
+        };
         let mut scaled_dt = f64::INFINITY;
         for (pi, part) in parts.iter().enumerate() {
             let elems: Vec<u32> = (0..mesh.elements.len() as u32)
@@ -305,8 +400,8 @@ impl Model {
             let mut scale = Vec::with_capacity(n);
             let lambda2mu = rho * c0 * c0;
             g.dt_kappa = surface_mode_factor(lambda2mu, law.initial_shear_modulus());
-            if let Some(ms) = mass_scaling {
-                g.dt_floor = ms.target_dt / (dt_factor * g.dt_kappa);
+            if let Some(t) = fixed_target {
+                g.dt_floor = t / (dt_factor * g.dt_kappa);
             }
             // Hourglass scaling of the part (see `HourglassModulus`): the stiffness form's
             // modulus, and the factor on c of the viscous form.
@@ -365,10 +460,10 @@ impl Model {
                     initial_dt = (dte, e);
                 }
                 let mut s = 1.0;
-                if let Some(ms) = mass_scaling {
+                if let Some(target) = fixed_target {
                     let own = dt_factor * dte;
-                    if own < ms.target_dt {
-                        s = (ms.target_dt / own).powi(2);
+                    if own < target {
+                        s = (target / own).powi(2);
                         part_mass[pi].scaled_elements += 1;
                     }
                 }
@@ -454,7 +549,13 @@ impl Model {
             n_slots: slot_offset,
             initial_dt,
             scaled_dt,
-            mass_scaling,
+            mass_scaling: match (mass_scaling, fixed_target) {
+                (Some(m), Some(t)) => Some(ResolvedMassScaling {
+                    target_dt: t,
+                    max_added: m.max_added,
+                }),
+                _ => None,
+            },
         })
     }
 

@@ -186,3 +186,41 @@ fn run_time_scaling_holds_the_target_step_of_a_crushed_block() {
     );
     let _ = std::fs::remove_dir_all(&out);
 }
+
+#[test]
+fn target_initial_keeps_the_initial_step_and_parses_with_clear_errors() {
+    use solver::model::StepTarget;
+    assert_eq!(StepTarget::parse("initial"), Ok(StepTarget::Initial(1.0)));
+    assert_eq!(
+        StepTarget::parse("4 x initial"),
+        Ok(StepTarget::Initial(4.0))
+    );
+    assert_eq!(StepTarget::parse("2 us"), Ok(StepTarget::Step(2e-6)));
+    for bad in ["2 kg", "x initial", "-1 x initial", "0 s", "soon"] {
+        let e = StepTarget::parse(bad).expect_err(bad);
+        println!("{bad:?}: {e}");
+        assert!(!e.is_empty());
+    }
+    // A bad target in a scene names the file and the key.
+    let ms = "[mass_scaling]\ntarget_dt = \"2 kg\"";
+    let spec: Result<solver::scene::SceneSpec, _> =
+        toml::from_str(&scene(1.0, "2 ms", "-1.5 mm", ms));
+    let e = spec.expect_err("a mass as target step").to_string();
+    assert!(e.contains("target_dt") && e.contains("time"), "{e}");
+
+    // "initial": nothing is added at the start, and the crushed block never steps below its
+    // initial step.
+    let ms = "[mass_scaling]\ntarget_dt = \"initial\"\nmax_added = 2.0";
+    let mut s = common::scene_from_str(&scene(1.0, "2 ms", "-1.5 mm", ms));
+    let dt0 = s.sim.settings.dt_factor * s.sim.model.initial_dt.0;
+    assert_eq!(s.sim.model.added_mass(), 0.0);
+    common::run_to_end(&mut s, "ms-initial");
+    let (lo, _) = s.sim.dt_range;
+    let pm = &s.sim.model.part_mass[0];
+    println!(
+        "target initial: dt >= {lo:.4e} (initial {dt0:.4e}), added {:.3} %",
+        100.0 * pm.added / pm.physical
+    );
+    assert!(lo >= dt0 * (1.0 - 1e-9));
+    assert!(pm.added > 0.0);
+}

@@ -58,9 +58,11 @@ pub struct PalpateArgs {
     /// the P-wave modulus, LS-DYNA types 1 and 4), 1pt-stiffness-shear, or full_fbar.
     #[arg(long, default_value = "one_point")]
     pub element: String,
-    /// Selective mass scaling to this time step, e.g. `4us` (off by default).
-    #[arg(long)]
-    pub mass_scaling: Option<String>,
+    /// Selective mass scaling: `initial` (default: an element gets mass only when it shrinks
+    /// below the initial stable step, so the step never falls; the added mass is reported),
+    /// `K x initial`, a time step such as `4us`, or `off`.
+    #[arg(long, default_value = "initial")]
+    pub mass_scaling: String,
     /// Time-step safety factor.
     #[arg(long, default_value_t = solver::simulation::DEFAULT_DT_FACTOR)]
     pub dt_factor: f64,
@@ -112,11 +114,12 @@ impl PalpateArgs {
             .element
             .parse::<ElementChoice>()
             .map_err(|e| format!("--element: {e}"))?;
-        s.mass_scaling_dt = self
-            .mass_scaling
-            .as_deref()
-            .map(|t| units::time(t, "--mass-scaling"))
-            .transpose()?;
+        s.mass_scaling = match self.mass_scaling.trim() {
+            "off" | "none" => None,
+            t => Some(
+                solver::model::StepTarget::parse(t).map_err(|e| format!("--mass-scaling: {e}"))?,
+            ),
+        };
         s.dt_factor = self.dt_factor;
         s.vtk = !self.no_vtk;
         s.title = match &s.place {
