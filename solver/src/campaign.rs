@@ -450,13 +450,8 @@ impl CampaignSpec {
             base.dt_factor = f.0;
         }
         if let Some(m) = &sv.mass_scaling {
-            base.mass_scaling = match m.trim() {
-                "off" | "none" => None,
-                t => Some(
-                    crate::model::StepTarget::parse(t)
-                        .map_err(|e| format!("solver.mass_scaling: {e}"))?,
-                ),
-            };
+            base.mass_scaling = crate::model::StepTarget::parse_switch(m)
+                .map_err(|e| format!("solver.mass_scaling: {e}"))?;
         }
         if let Some(l) = sv.mass_scaling_limit {
             base.mass_scaling_limit = l.0;

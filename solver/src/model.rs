@@ -165,8 +165,6 @@ pub struct Group {
     pub dt_floor: f64,
     /// Lumped volume of each element node (m^3), kept only with mass scaling (to add mass).
     pub lumped: Vec<[f64; 8]>,
-    /// Reference density of the part's law (kg/m^3).
-    pub rho: f64,
 }
 
 /// Elements per parallel chunk. Fixed, so partial sums are formed in the same order for any
@@ -216,12 +214,44 @@ impl StepTarget {
             }
             return Ok(StepTarget::Initial(k));
         }
-        let q = material::quantity::Quantity::parse(t)?;
-        let v = q.get(material::quantity::Dim::TIME)?;
+        let hint = "expected a time step such as \"2 us\", \"initial\" or \"<k> x initial\"";
+        let q = material::quantity::Quantity::parse(t).map_err(|e| format!("{e}; {hint}"))?;
+        let v = q
+            .get(material::quantity::Dim::TIME)
+            .map_err(|e| format!("{e}; {hint}"))?;
         if !(v > 0.0 && v.is_finite()) {
             return Err(format!("`{s}`: the target step must be positive"));
         }
         Ok(StepTarget::Step(v))
+    }
+}
+
+impl StepTarget {
+    /// Parse a command-line or campaign switch: `"off"` (or `"none"`) for no mass scaling,
+    /// otherwise as [`StepTarget::parse`].
+    pub fn parse_switch(s: &str) -> Result<Option<StepTarget>, String> {
+        match s.trim() {
+            "off" | "none" => Ok(None),
+            t => StepTarget::parse(t).map(Some),
+        }
+    }
+}
+
+/// In a scene: a time with its unit (a plain number is seconds), `"initial"` or
+/// `"<k> x initial"`.
+impl<'de> serde::Deserialize<'de> for StepTarget {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        #[derive(serde::Deserialize)]
+        #[serde(untagged)]
+        enum Raw {
+            Number(f64),
+            Text(String),
+        }
+        match Raw::deserialize(d)? {
+            Raw::Number(v) => StepTarget::parse(&v.to_string()),
+            Raw::Text(s) => StepTarget::parse(&s),
+        }
+        .map_err(serde::de::Error::custom)
     }
 }
 
@@ -296,20 +326,17 @@ pub fn initial_element_dt(x: &[[f64; 3]; 8], volume: f64, c: f64) -> f64 {
     volume / max_face_area(&xt) / c
 }
 
+/// A law's initial wave speed `c0` (m/s) and the surface-mode factor `kappa` of its stable step.
+fn step_constants(law: &Material) -> (f64, f64) {
+    let c0 = law.initial_wave_speed();
+    let m = law.density() * c0 * c0;
+    (c0, surface_mode_factor(m, law.initial_shear_modulus()))
+}
+
 /// Smallest initial `kappa L / c` over the mesh (s), without mass scaling. Inverted elements
 /// are skipped here (the model build reports them).
 fn natural_step(mesh: &Mesh, parts: &[Part]) -> f64 {
-    let props: Vec<(f64, f64)> = parts
-        .iter()
-        .map(|p| {
-            let c0 = p.material.initial_wave_speed();
-            let m = p.material.density() * c0 * c0;
-            (
-                c0,
-                surface_mode_factor(m, p.material.initial_shear_modulus()),
-            )
-        })
-        .collect();
+    let props: Vec<(f64, f64)> = parts.iter().map(|p| step_constants(&p.material)).collect();
     let mut dt = f64::INFINITY;
     for (e, conn) in mesh.elements.iter().enumerate() {
         let x: [[f64; 3]; 8] = std::array::from_fn(|a| mesh.nodes[conn[a] as usize]);
@@ -373,7 +400,7 @@ impl Model {
             let form = part.formulation;
             let law = &part.material;
             let rho = law.density();
-            let c0 = law.initial_wave_speed();
+            let (c0, kappa) = step_constants(law);
             let n_ip = form.n_ip();
             let stride = law.history_len() * n_ip;
             let mut g = Group {
@@ -395,11 +422,10 @@ impl Model {
                 dt_kappa: 1.0,
                 dt_floor: 0.0,
                 lumped: Vec::new(),
-                rho,
             };
             let mut scale = Vec::with_capacity(n);
             let lambda2mu = rho * c0 * c0;
-            g.dt_kappa = surface_mode_factor(lambda2mu, law.initial_shear_modulus());
+            g.dt_kappa = kappa;
             if let Some(t) = fixed_target {
                 g.dt_floor = t / (dt_factor * g.dt_kappa);
             }

@@ -257,6 +257,7 @@ const T_GATHER: usize = 1;
 const T_LOADS: usize = 2;
 const T_CONTACT: usize = 3;
 const T_UPDATE: usize = 4;
+const T_MASS_SCALING: usize = 5;
 
 impl Simulation {
     /// Set up a simulation. Initial velocities may be given per node.
@@ -327,13 +328,20 @@ impl Simulation {
             .zip(&model.mass)
             .map(|(v, m)| 0.5 * m * (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]))
             .sum();
-        let timers = ["element forces", "assembly", "loads", "contact", "update"]
-            .into_iter()
-            .map(|name| StageTime {
-                name,
-                time: Duration::ZERO,
-            })
-            .collect();
+        let timers = [
+            "element forces",
+            "assembly",
+            "loads",
+            "contact",
+            "update",
+            "mass scaling",
+        ]
+        .into_iter()
+        .map(|name| StageTime {
+            name,
+            time: Duration::ZERO,
+        })
+        .collect();
         Ok(Simulation {
             model,
             settings,
@@ -467,7 +475,7 @@ impl Simulation {
         })?;
         self.totals = tot;
         if self.model.mass_scaling.is_some() {
-            self.apply_run_time_mass_scaling()?;
+            self.time_stage(T_MASS_SCALING, |s| s.apply_run_time_mass_scaling())?;
         }
         self.erosion.count += tot.newly_eroded as u64;
         if self.erosion.first.is_none() {
@@ -499,12 +507,14 @@ impl Simulation {
         let mut energy = 0.0;
         let mut last = None;
         let Model {
+            parts,
             groups,
             mass,
             part_mass,
             ..
         } = &mut self.model;
         for g in groups.iter_mut() {
+            let rho = parts[g.part].material.density();
             for ch in g.chunks.iter() {
                 for &(le, s_new) in &ch.rescale {
                     let le = le as usize;
@@ -512,13 +522,13 @@ impl Simulation {
                     let ds = s_new - s_old;
                     for a in 0..8 {
                         let n = g.conn[le][a] as usize;
-                        let dm = g.rho * ds * g.lumped[le][a];
+                        let dm = rho * ds * g.lumped[le][a];
                         mass[n] += dm;
                         let v = self.v[n];
                         energy += 0.5 * dm * (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
                     }
                     let pm = &mut part_mass[g.part];
-                    pm.added += g.rho * ds * g.vol0[le];
+                    pm.added += rho * ds * g.vol0[le];
                     if s_old == 1.0 {
                         pm.scaled_elements += 1;
                     }

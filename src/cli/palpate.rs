@@ -114,12 +114,8 @@ impl PalpateArgs {
             .element
             .parse::<ElementChoice>()
             .map_err(|e| format!("--element: {e}"))?;
-        s.mass_scaling = match self.mass_scaling.trim() {
-            "off" | "none" => None,
-            t => Some(
-                solver::model::StepTarget::parse(t).map_err(|e| format!("--mass-scaling: {e}"))?,
-            ),
-        };
+        s.mass_scaling = solver::model::StepTarget::parse_switch(&self.mass_scaling)
+            .map_err(|e| format!("--mass-scaling: {e}"))?;
         s.dt_factor = self.dt_factor;
         s.vtk = !self.no_vtk;
         s.title = match &s.place {

@@ -69,8 +69,8 @@ struct RunData {
     centroids: Vec<[f64; 3]>,
 }
 
-/// The base setting and the variants of a study.
-fn plan(quick: bool) -> (PalpationSetup, Vec<(String, String, PalpationSetup)>) {
+/// The variants of a study: (knob, setting, palpation), each a change of one base setting.
+fn plan(quick: bool) -> Vec<(String, String, PalpationSetup)> {
     // The base runs without mass scaling (the study's "none"); the mass-scaling knob adds it.
     let mut base = PalpationSetup {
         vtk: false,
@@ -144,7 +144,7 @@ fn plan(quick: bool) -> (PalpationSetup, Vec<(String, String, PalpationSetup)>) 
             },
         ));
     }
-    (base, v)
+    v
 }
 
 /// Run one setting into `dir`, sharing phantoms by voxel size.
@@ -241,11 +241,8 @@ pub fn run_study(
     out: &Path,
     mut progress: impl FnMut(usize, usize, &str),
 ) -> Result<Vec<StudyRow>, String> {
-    let (base, variants) = plan(quick);
+    let variants = plan(quick);
     let mut phantoms = HashMap::new();
-    // The base phantom, shared by the runs at its voxel size.
-    let p = solver::phantom::build(&base.phantom_params()?)?;
-    phantoms.insert(base.voxel.to_bits(), p);
     let n = variants.len();
     let mut data: Vec<Result<RunData, String>> = Vec::new();
     for (i, (knob, setting, s)) in variants.iter().enumerate() {

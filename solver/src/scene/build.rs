@@ -614,7 +614,7 @@ pub fn build_scene_with(
         None => Some(BulkViscosity::default()),
     };
     let mass_scaling = spec.mass_scaling.as_ref().map(|m| MassScaling {
-        target: m.target_dt.0,
+        target: m.target_dt,
         max_added: m.max_added.map(|x| x.0).unwrap_or(0.05),
     });
     let damping = spec

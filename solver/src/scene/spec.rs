@@ -247,30 +247,9 @@ pub struct BulkViscositySpec {
 pub struct MassScalingSpec {
     /// Target time step: a time, `"initial"` (the initial stable step: elements get mass only
     /// once they shrink during the run) or `"<k> x initial"`.
-    pub target_dt: StepTargetSpec,
+    pub target_dt: crate::model::StepTarget,
     /// Largest added mass as a fraction of the physical mass (default 0.05).
     pub max_added: Option<Number>,
-}
-
-/// A mass-scaling target as written in a scene: a time with its unit (a plain number is
-/// seconds), `"initial"` or `"<k> x initial"`.
-#[derive(Clone, Copy, Debug)]
-pub struct StepTargetSpec(pub crate::model::StepTarget);
-
-impl<'de> Deserialize<'de> for StepTargetSpec {
-    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
-        #[derive(Deserialize)]
-        #[serde(untagged)]
-        enum Raw {
-            Number(f64),
-            Text(String),
-        }
-        let t = match Raw::deserialize(d)? {
-            Raw::Number(v) => crate::model::StepTarget::parse(&v.to_string()),
-            Raw::Text(s) => crate::model::StepTarget::parse(&s),
-        };
-        t.map(StepTargetSpec).map_err(serde::de::Error::custom)
-    }
 }
 
 /// `[relaxation]`.
