@@ -37,6 +37,12 @@ pub enum LawError {
     /// det F <= 0: the element has inverted.
     #[error("non-positive Jacobian det F = {0:.3e} (element inverted)")]
     NonPositiveJacobian(f64),
+    /// A fully integrated element's Gauss point has lost nearly all its volume.
+    #[error(
+        "excessively distorted: Gauss-point volume ratio det F = {0:.3e} is below {1} (the \
+         element is nearly inverted and its stable-step estimate no longer bounds its modes)"
+    )]
+    ExcessiveDistortion(f64, f64),
     /// The stress or wave speed is not finite.
     #[error("non-finite stress or wave speed ({0})")]
     NotFinite(&'static str),

@@ -22,6 +22,10 @@ pub struct ElementTotals {
     pub hg_stored: f64,
     /// Hourglass dissipation power (W).
     pub hg_power: f64,
+    /// Largest hourglass energy of one element this step (J): stored energy plus power x dt.
+    pub hg_peak: f64,
+    /// The element (global id) with that largest hourglass energy.
+    pub hg_peak_elem: u32,
     /// Bulk-viscous power (W).
     pub bulk_power: f64,
     /// Law dissipation this step (J).
@@ -141,6 +145,11 @@ pub fn element_loop(
                             }
                             acc.hg_stored += o.hourglass_stored;
                             acc.hg_power += o.hourglass_power;
+                            let hg = o.hourglass_stored + o.hourglass_power * input.dt;
+                            if hg > acc.hg_peak {
+                                acc.hg_peak = hg;
+                                acc.hg_peak_elem = elements[le];
+                            }
                             acc.bulk_power += o.bulk_power;
                             acc.law_dissipation += o.law_dissipation;
                             if o.failed {
@@ -185,6 +194,10 @@ pub fn element_loop(
             }
             tot.hg_stored += ch.hg_stored;
             tot.hg_power += ch.hg_power;
+            if ch.hg_peak > tot.hg_peak {
+                tot.hg_peak = ch.hg_peak;
+                tot.hg_peak_elem = ch.hg_peak_elem;
+            }
             tot.bulk_power += ch.bulk_power;
             tot.law_dissipation += ch.law_dissipation;
         }

@@ -108,6 +108,10 @@ pub struct ChunkOut {
     pub hg_stored: f64,
     /// Hourglass power.
     pub hg_power: f64,
+    /// Largest hourglass energy of one element (stored + power x dt).
+    pub hg_peak: f64,
+    /// The element (global id) with it.
+    pub hg_peak_elem: u32,
     /// Bulk-viscous power.
     pub bulk_power: f64,
     /// Law dissipation.

@@ -57,24 +57,33 @@ pub struct Energies {
 }
 
 impl Energies {
-    /// The normalised energy error.
-    pub fn error(&self) -> f64 {
-        let bal = self.kinetic
+    /// The imbalance `KE + IE + E_hg + E_bv + E_damp + E_contact - W_ext - KE_0` (J).
+    pub fn imbalance(&self) -> f64 {
+        self.kinetic
             + self.internal
             + self.hourglass
             + self.bulk_viscous
             + self.damping
             + self.contact
             - self.external
-            - self.initial_kinetic;
-        let scale = self
-            .kinetic
+            - self.initial_kinetic
+    }
+
+    /// The energy scale the imbalance is measured against: `max(|KE|, |IE|, |W_ext|, KE_0)`.
+    pub fn scale(&self) -> f64 {
+        self.kinetic
             .abs()
             .max(self.internal.abs())
             .max(self.external.abs())
-            .max(self.initial_kinetic);
+            .max(self.initial_kinetic)
+    }
+
+    /// The normalised energy error `|imbalance| / scale` at this instant (Belytschko, Liu and
+    /// Moran, *Nonlinear Finite Elements*, 2000, sec. 6.2.3).
+    pub fn error(&self) -> f64 {
+        let scale = self.scale();
         if scale > 0.0 {
-            bal.abs() / scale
+            self.imbalance().abs() / scale
         } else {
             0.0
         }
@@ -164,6 +173,20 @@ pub struct LoopSettings {
     pub dt_max: f64,
     /// Smallest allowed step before the run is stopped (s).
     pub dt_min: f64,
+    /// Stop the run when hourglass energy passes a share of the internal energy.
+    pub hourglass_limit: Option<HourglassLimit>,
+}
+
+/// The hourglass guard: a run whose hourglass energy exceeds `ratio` x internal energy at any
+/// time after `after` stops with an error naming the element with the largest hourglass energy
+/// in that step. The guard reads totals the element loop forms anyway, so it costs nothing.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct HourglassLimit {
+    /// Largest allowed hourglass / internal energy.
+    pub ratio: f64,
+    /// Time (s) from which the ratio is checked (the start, where the internal energy is
+    /// still near zero, would trip it on noise).
+    pub after: f64,
 }
 
 impl Default for LoopSettings {
@@ -176,6 +199,7 @@ impl Default for LoopSettings {
             relaxation: None,
             dt_max: f64::INFINITY,
             dt_min: 0.0,
+            hourglass_limit: None,
         }
     }
 }
@@ -645,9 +669,36 @@ impl Simulation {
         self.time += dt;
         self.dt_prev = dt;
         self.dt_range = (self.dt_range.0.min(dt), self.dt_range.1.max(dt));
+        self.check_hourglass()?;
         // Forces at the new state, for the next step (and its stable dt).
         let want = self.stress.is_some() && self.time >= stress_at;
         self.internal_forces(want)
+    }
+
+    /// The hourglass guard ([`HourglassLimit`]), on the energies just formed at t^n.
+    fn check_hourglass(&self) -> Result<(), SolverError> {
+        let Some(lim) = self.settings.hourglass_limit else {
+            return Ok(());
+        };
+        let (hg, ie) = (self.energy.hourglass, self.energy.internal);
+        if self.time < lim.after || !(ie > 0.0) || hg <= lim.ratio * ie {
+            return Ok(());
+        }
+        let e = self.totals.hg_peak_elem;
+        Err(SolverError::ElementFailure {
+            element: e,
+            part: self.part_of(e),
+            time: self.time,
+            reason: format!(
+                "hourglass energy is {:.1} % of the internal energy (limit {:.1} %); this element \
+                 has the largest hourglass energy ({:.3e} J in this step). The one-point element's \
+                 zero-energy modes carry the deformation here: use the fully integrated element \
+                 (full_fbar), the stiffness hourglass form, or a finer mesh under the load",
+                100.0 * hg / ie,
+                100.0 * lim.ratio,
+                self.totals.hg_peak
+            ),
+        })
     }
 
     /// The nodal update with kinematic conditions and the energy sums.

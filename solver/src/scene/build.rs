@@ -9,7 +9,7 @@ use crate::generate::{box_mesh, BoxSpec};
 use crate::mesh::Mesh;
 use crate::model::{MassScaling, Model, Part};
 use crate::phantom::Phantom;
-use crate::simulation::{DynamicRelaxation, LoopSettings, Simulation};
+use crate::simulation::{DynamicRelaxation, HourglassLimit, LoopSettings, Simulation};
 use material::quantity::Length;
 use material::Material;
 use std::path::{Path, PathBuf};
@@ -647,6 +647,24 @@ pub fn build_scene_with(
         relaxation,
         dt_max: spec.run.dt_max.map(|t| t.0).unwrap_or(f64::INFINITY),
         dt_min: spec.run.dt_min.map(|t| t.0).unwrap_or(1e-6 * dt0),
+        hourglass_limit: match spec.run.max_hourglass_ratio {
+            Some(r) if !(r.0 > 0.0) => {
+                return Err(format!(
+                    "{}: run.max_hourglass_ratio must be positive (got {})",
+                    path.display(),
+                    r.0
+                ))
+            }
+            Some(r) => Some(HourglassLimit {
+                ratio: r.0,
+                after: spec
+                    .run
+                    .hourglass_check_after
+                    .map(|t| t.0)
+                    .unwrap_or(0.1 * end_time),
+            }),
+            None => None,
+        },
     };
     let want_stress = plan.needs_stress() || plan.probe.is_some();
     let mut sim = Simulation::new(model, settings, constraints, loads, v0, want_stress)

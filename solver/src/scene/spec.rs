@@ -68,6 +68,11 @@ pub struct RunSpec {
     pub dt_max: Option<Time>,
     /// Stop if the step falls below this (default: 1e-6 of the initial step).
     pub dt_min: Option<Time>,
+    /// Hourglass guard: stop, naming the element, when hourglass energy exceeds this share of
+    /// the internal energy (e.g. 0.1). Off when absent.
+    pub max_hourglass_ratio: Option<Number>,
+    /// From when the guard checks (default: 10 % of the end time).
+    pub hourglass_check_after: Option<Time>,
     /// A title.
     pub title: Option<String>,
 }
