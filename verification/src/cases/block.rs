@@ -15,7 +15,10 @@
 //! Q1 meshes (4x4x2, 8x8x4, 16x16x8) with FEniCSx's Q1 solution on each, and a Q2 16x16x8
 //! reference. palpa runs the same meshes with the plain fully integrated element (the same
 //! discrete problem as FEniCSx Q1: it must agree to the relaxation tolerance), with F-bar
-//! (within 1 % of FEniCSx Q1 on the finest mesh) and with one-point integration (stiffness
+//! (reaction within 1 % of FEniCSx Q1 on the finest mesh, and reaction and bulge within 1 %
+//! of the converged Q2 reference there; its bulge is not compared with Q1's at 1 %, because
+//! F-bar is a different element that does not share Q1's volumetric stiffening: on 16x16x8 it is
+//! 0.3 % from Q2 where Q1 is 0.9 % away) and with one-point integration (stiffness
 //! hourglass control; reported). The errors against the Q2 reference give the observed
 //! convergence rates, log(e_coarse / e_fine) / log 2.
 
@@ -77,7 +80,7 @@ pub fn roller_block(form: solver::element::Formulation) -> Result<(f64, f64, f64
         lambda,
         mu,
     });
-    let r = relax(model(m, mat, form)?, c, Vec::new(), 1e-12, 100_000)?;
+    let r = relax(model(m, mat, form)?, c, Vec::new(), 1e-10, 100_000)?;
     if !r.converged {
         return Err(format!(
             "relaxation: residual {:.2e} after {} steps",
@@ -271,7 +274,7 @@ pub fn clamped() -> CaseOutput {
                         ru,
                         ux,
                         ru,
-                        tol,
+                        if form == FULL { tol } else { None },
                     ));
                     out.notes
                         .push(format!("{case}: {steps} relaxation steps, {secs:.1} s"));
@@ -284,6 +287,7 @@ pub fn clamped() -> CaseOutput {
                     if k == finest {
                         let src = "FEniCSx Q2 16x16x8 (converged)";
                         let case = format!("clamped block {name}, {} vs Q2", short(&form));
+                        let tol = (form == FULL_FBAR).then_some(CLAMPED_FBAR_TOLERANCE);
                         out.rows.push(Row::compare(
                             &case,
                             "plate reaction F_z (N)",
@@ -291,7 +295,7 @@ pub fn clamped() -> CaseOutput {
                             q2_f,
                             fz,
                             q2_f,
-                            None,
+                            tol,
                         ));
                         out.rows.push(Row::compare(
                             &case,
@@ -300,7 +304,7 @@ pub fn clamped() -> CaseOutput {
                             q2_u,
                             ux,
                             q2_u,
-                            None,
+                            tol,
                         ));
                     }
                 }

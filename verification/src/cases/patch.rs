@@ -50,7 +50,7 @@ pub fn patch_errors(reference: &str, form: Formulation) -> Result<PatchResult, S
     for (&n, &u) in nodes.iter().zip(&vals) {
         prescribe_node(&mut c, n, u);
     }
-    let r = relax(model(m, mat, form)?, c, Vec::new(), 1e-13, 200_000)?;
+    let r = relax(model(m, mat, form)?, c, Vec::new(), 1e-12, 200_000)?;
     if !r.converged {
         return Err(format!(
             "dynamic relaxation did not converge: residual {:.2e} after {} steps",
