@@ -417,6 +417,12 @@ pub struct SceneRun {
     pub time: f64,
     /// Steps taken.
     pub steps: u64,
+    /// Elements.
+    pub elements: usize,
+    /// Wall time of the run (s).
+    pub wall: f64,
+    /// Mass added by mass scaling, percent of the physical mass.
+    pub added_mass_percent: f64,
 }
 
 /// Write `scene` to a temporary directory, run it, and read the indenter `name`'s force.
@@ -443,6 +449,15 @@ pub fn run_contact_scene(scene: &str, tag: &str, name: &str) -> Result<SceneRun,
                 / summary.internal_energy.abs().max(1e-300),
             time: summary.time,
             steps: summary.steps,
+            elements: summary.elements,
+            wall: summary.wall_seconds,
+            added_mass_percent: {
+                let (p, a) = summary
+                    .mass
+                    .iter()
+                    .fold((0.0, 0.0), |(p, a), m| (p + m.physical_kg, a + m.added_kg));
+                100.0 * a / p.max(1e-300)
+            },
         })
     })();
     let _ = std::fs::remove_dir_all(&dir);

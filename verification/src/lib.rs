@@ -25,6 +25,7 @@ pub mod plot;
 pub mod quasi;
 pub mod report;
 pub mod study;
+pub mod study_hertz;
 
 pub use report::{Row, Status};
 

@@ -17,8 +17,11 @@
 //!   with the run's ROI element whose centroid is nearest (meshes of different voxel size have
 //!   different ROIs).
 //!
-//! The study writes `study.csv`, `study.md` and the Pareto plots `pareto_force.png` and
-//! `pareto_stress.png` (error against wall time, one line per knob). `--quick` uses a coarse
+//! The same knobs then run on the Hertz block ([`crate::study_hertz`]), whose error is measured
+//! against Hertz's closed form (knobs `hertz mesh`, `hertz element`, ...).
+//!
+//! The study writes `study.csv`, `study.md` and the Pareto plots `pareto_force.png`,
+//! `pareto_stress.png` and `pareto_hertz.png` (error against wall time, one line per knob). `--quick` uses a coarse
 //! phantom and a short indentation (6 mm in 6 ms) so that it finishes in a few minutes on two
 //! cores; the full study runs the paper's 15 mm in 25 ms.
 
@@ -58,6 +61,30 @@ pub struct StudyRow {
     pub stress_error: f64,
     /// `completed` or the error.
     pub status: String,
+}
+
+impl StudyRow {
+    /// A setting whose run failed.
+    pub fn failed(knob: String, setting: String, e: String) -> StudyRow {
+        StudyRow {
+            knob,
+            setting,
+            elements: 0,
+            steps: 0,
+            element_cycles: 0.0,
+            wall: 0.0,
+            added_mass_percent: 0.0,
+            peak_force: f64::NAN,
+            force_error: f64::NAN,
+            stress_error: f64::NAN,
+            status: format!("failed: {e}"),
+        }
+    }
+
+    /// Whether the row belongs to the Hertz block.
+    pub fn is_hertz(&self) -> bool {
+        self.knob.starts_with("hertz")
+    }
 }
 
 /// What one run left behind, for the error computation.
@@ -243,7 +270,7 @@ pub fn run_study(
 ) -> Result<Vec<StudyRow>, String> {
     let variants = plan(quick);
     let mut phantoms = HashMap::new();
-    let n = variants.len();
+    let n = variants.len() + crate::study_hertz::count(quick);
     let mut data: Vec<Result<RunData, String>> = Vec::new();
     for (i, (knob, setting, s)) in variants.iter().enumerate() {
         progress(i, n, &format!("{knob}: {setting}"));
@@ -282,21 +309,14 @@ pub fn run_study(
                 stress_error: stress_error(r, reference),
                 status: r.summary.status.clone(),
             },
-            Err(e) => StudyRow {
-                knob: knob.clone(),
-                setting: setting.clone(),
-                elements: 0,
-                steps: 0,
-                element_cycles: 0.0,
-                wall: 0.0,
-                added_mass_percent: 0.0,
-                peak_force: f64::NAN,
-                force_error: f64::NAN,
-                stress_error: f64::NAN,
-                status: format!("failed: {e}"),
-            },
+            Err(e) => StudyRow::failed(knob.clone(), setting.clone(), e.clone()),
         })
-        .collect();
+        .collect::<Vec<_>>();
+    let first = variants.len();
+    let mut rows = rows;
+    rows.extend(crate::study_hertz::run(quick, |i, what| {
+        progress(first + i, n, what)
+    }));
     Ok(rows)
 }
 
@@ -330,10 +350,17 @@ pub fn to_markdown(rows: &[StudyRow]) -> String {
     let mut s = String::from(
         "| knob | setting | elements | steps | element-cycles | wall (s) | added mass | peak force (N) | force error | ROI stress error |\n|---|---|---|---|---|---|---|---|---|---|\n",
     );
+    let pct = |x: f64| {
+        if x.is_finite() {
+            format!("{:.2} %", 100.0 * x)
+        } else {
+            "-".to_string()
+        }
+    };
     for r in rows {
         let _ = writeln!(
             s,
-            "| {} | {} | {} | {} | {:.3e} | {:.2} | {:.1} % | {:.3} | {:.2} % | {:.2} % |",
+            "| {} | {} | {} | {} | {:.3e} | {:.2} | {:.1} % | {:.3} | {} | {} |",
             r.knob,
             r.setting,
             r.elements,
@@ -342,11 +369,15 @@ pub fn to_markdown(rows: &[StudyRow]) -> String {
             r.wall,
             r.added_mass_percent,
             r.peak_force,
-            100.0 * r.force_error,
-            100.0 * r.stress_error
+            pct(r.force_error),
+            pct(r.stress_error)
         );
     }
-    s.push('\n');
+    s.push_str(
+        "\nPalpation rows: force and ROI-stress errors are relative RMS differences from the \
+         reference run over the whole history. Hertz rows: the force error is the final indenter \
+         force against Hertz's closed form; peak force is that final force (quarter model).\n\n",
+    );
     s.push_str(&recommendation(rows));
     s
 }
@@ -357,11 +388,13 @@ pub fn recommendation(rows: &[StudyRow]) -> String {
     let Some(reference) = rows.iter().find(|r| r.knob == "reference") else {
         return String::new();
     };
-    let mut s = String::new();
+    let mut s = String::from("Palpation (against the reference run):\n");
     for tol in [0.01, 0.05, 0.10] {
         let best = rows
             .iter()
-            .filter(|r| r.knob != "reference" && r.force_error <= tol && r.wall > 0.0)
+            .filter(|r| {
+                r.knob != "reference" && !r.is_hertz() && r.force_error <= tol && r.wall > 0.0
+            })
             .min_by(|a, b| a.wall.total_cmp(&b.wall));
         match best {
             Some(b) => {
@@ -387,19 +420,62 @@ pub fn recommendation(rows: &[StudyRow]) -> String {
             }
         }
     }
+    let hertz: Vec<&StudyRow> = rows
+        .iter()
+        .filter(|r| r.is_hertz() && r.wall > 0.0)
+        .collect();
+    if let Some(dearest) = hertz.iter().max_by(|a, b| a.wall.total_cmp(&b.wall)) {
+        s.push_str("\nHertz block (against the closed form):\n");
+        for tol in [0.02, 0.05, 0.10] {
+            match hertz
+                .iter()
+                .filter(|r| r.force_error <= tol)
+                .min_by(|a, b| a.wall.total_cmp(&b.wall))
+            {
+                Some(b) => {
+                    let _ = writeln!(
+                        s,
+                        "- force error <= {:.0} %: {} = {} gives {:.2} % at {:.0} % of the dearest Hertz run's wall time ({:.2} s of {:.2} s, {}).",
+                        100.0 * tol,
+                        b.knob,
+                        b.setting,
+                        100.0 * b.force_error,
+                        100.0 * b.wall / dearest.wall,
+                        b.wall,
+                        dearest.wall,
+                        dearest.setting
+                    );
+                }
+                None => {
+                    let _ = writeln!(
+                        s,
+                        "- no Hertz setting reaches a force error of {:.0} %.",
+                        100.0 * tol
+                    );
+                }
+            }
+        }
+    }
     s
 }
 
 /// Draw the two Pareto plots into `out`; returns the file names.
 pub fn plots(rows: &[StudyRow], out: &Path) -> Result<Vec<String>, String> {
     let mut files = Vec::new();
-    for (which, title) in [("force", "force error"), ("stress", "ROI stress error")] {
+    for (which, title) in [
+        ("force", "force error"),
+        ("stress", "ROI stress error"),
+        ("hertz", "Hertz force error"),
+    ] {
         let mut curves: Vec<(String, Vec<(f64, f64)>)> = Vec::new();
-        for r in rows.iter().filter(|r| r.wall > 0.0) {
-            let e = if which == "force" {
-                r.force_error
-            } else {
+        for r in rows
+            .iter()
+            .filter(|r| r.wall > 0.0 && r.is_hertz() == (which == "hertz"))
+        {
+            let e = if which == "stress" {
                 r.stress_error
+            } else {
+                r.force_error
             };
             let e = e.max(1e-6);
             match curves.iter_mut().find(|c| c.0 == r.knob) {
@@ -412,7 +488,11 @@ pub fn plots(rows: &[StudyRow], out: &Path) -> Result<Vec<String>, String> {
         }
         let series = crate::Series {
             plot: format!("pareto_{which}"),
-            title: format!("{title} against wall time (relative RMS vs the reference run)"),
+            title: if which == "hertz" {
+                format!("{title} against wall time (relative, vs the closed form)")
+            } else {
+                format!("{title} against wall time (relative RMS vs the reference run)")
+            },
             axes: ("wall time (s)".into(), format!("{title} (relative)")),
             log: true,
             curves,

@@ -473,7 +473,7 @@ pub fn hertz() -> CaseOutput {
     let mut out = CaseOutput::default();
     let case = "Hertz contact, rigid sphere R 5 mm, d 0.5 mm";
     let q = "indenter force F_z (N), quarter model";
-    match crate::hard::run_contact_scene(HERTZ_SCENE, "hertz", "sphere") {
+    match crate::hard::run_contact_scene(&hertz_scene(24, "", None, None), "hertz", "sphere") {
         Err(e) if e.contains("not implemented") => out.rows.push(Row::not_yet(
             case,
             q,
@@ -481,8 +481,7 @@ pub fn hertz() -> CaseOutput {
         )),
         Err(e) => out.rows.push(Row::failed(case, q, e)),
         Ok(r) => {
-            let (e, nu, radius, d) = (30e3f64, 0.49f64, 5e-3f64, 0.5e-3f64);
-            let f = 4.0 / 3.0 * e / (1.0 - nu * nu) * radius.sqrt() * d.powf(1.5) / 4.0;
+            let f = hertz_force();
             out.rows.push(Row::compare(
                 case,
                 q,
@@ -506,17 +505,39 @@ pub fn hertz() -> CaseOutput {
     out
 }
 
-/// The Hertz scene (a copy of `scenes/hertz-sphere.toml`).
-pub const HERTZ_SCENE: &str = r#"
+/// Hertz's force on the quarter model (N): `F = 4/3 E / (1 - nu^2) sqrt(R) d^1.5 / 4` for the
+/// scene's E = 30 kPa, nu = 0.49, R = 5 mm, d = 0.5 mm.
+pub fn hertz_force() -> f64 {
+    let (e, nu, radius, d) = (30e3f64, 0.49f64, 5e-3f64, 0.5e-3f64);
+    4.0 / 3.0 * e / (1.0 - nu * nu) * radius.sqrt() * d.powf(1.5) / 4.0
+}
+
+/// The Hertz scene (`scenes/hertz-sphere.toml` with `div` graded elements per edge; the verify
+/// case uses 24). `part_keys` are extra `[[part]]` keys (the formulation), `dt_factor` the time-
+/// step factor and `mass_scaling` a target of that many times the initial stable step.
+pub fn hertz_scene(
+    div: usize,
+    part_keys: &str,
+    dt_factor: Option<f64>,
+    mass_scaling: Option<f64>,
+) -> String {
+    let dt = dt_factor
+        .map(|f| format!("dt_factor = {f}\n"))
+        .unwrap_or_default();
+    let ms = mass_scaling
+        .map(|k| format!("[mass_scaling]\ntarget_dt = \"{k} x initial\"\nmax_added = 1000.0\n"))
+        .unwrap_or_default();
+    format!(
+        r#"
 [run]
 title = "Hertz sphere (verification)"
 end_time = "70 ms"
-
+{dt}
 [mesh]
 generator = "box"
 origin = ["0 mm", "0 mm", "-60 mm"]
 size = ["60 mm", "60 mm", "60 mm"]
-divisions = [24, 24, 24]
+divisions = [{div}, {div}, {div}]
 grading = [66.0, 66.0, 0.01515]
 part = "block"
 
@@ -529,6 +550,7 @@ poisson_ratio = 0.49
 [[part]]
 name = "block"
 material = "gel"
+{part_keys}
 
 [[boundary]]
 nodes = "xmin"
@@ -543,11 +565,12 @@ symmetry = "z"
 [damping]
 mass_proportional = 20.0
 
+{ms}
 [[indenter]]
 name = "sphere"
 direction = [0, 0, -1]
-motion = { kind = "displacement", curve = { kind = "smooth_step", value = "0.5 mm", end = "60 ms" } }
-part = [{ shape = "sphere", center = ["0 mm", "0 mm", "5 mm"], radius = "5 mm" }]
+motion = {{ kind = "displacement", curve = {{ kind = "smooth_step", value = "0.5 mm", end = "60 ms" }} }}
+part = [{{ shape = "sphere", center = ["0 mm", "0 mm", "5 mm"], radius = "5 mm" }}]
 
 [contact]
 surface = "zmax"
@@ -556,4 +579,6 @@ surface = "zmax"
 interval = "70 ms"
 history_interval = "0.5 ms"
 fields = ["displacement"]
-"#;
+"#
+    )
+}
