@@ -104,6 +104,7 @@ pub fn run(quick: bool, mut progress: impl FnMut(usize, &str)) -> Vec<StudyRow> 
                 Ok(r) => StudyRow {
                     knob,
                     setting,
+                    against: "Hertz closed form".into(),
                     elements: r.elements,
                     steps: r.steps,
                     element_cycles: r.elements as f64 * r.steps as f64,
