@@ -536,7 +536,8 @@ impl Simulation {
             return Ok(());
         };
         let mut energy = 0.0;
-        let mut last = None;
+        // The element that needed the largest density scale in this step.
+        let mut worst: Option<(f64, u32)> = None;
         let Model {
             parts,
             groups,
@@ -564,26 +565,44 @@ impl Simulation {
                         pm.scaled_elements += 1;
                     }
                     g.density_scale[le] = s_new;
-                    last = Some(g.elements[le]);
+                    if worst.is_none_or(|(w, _)| s_new > w) {
+                        worst = Some((s_new, g.elements[le]));
+                    }
                 }
             }
         }
         self.w_ext_acc += energy;
-        if let Some(e) = last {
+        if let Some((scale, e)) = worst {
             let added = self.model.added_mass();
             let phys = self.model.physical_mass();
             if added > ms.max_added * phys {
+                // The part that took the largest share of its own mass.
+                let (_, pm) = self
+                    .model
+                    .part_mass
+                    .iter()
+                    .enumerate()
+                    .max_by(|a, b| {
+                        let r = |m: &crate::model::PartMass| m.added / m.physical.max(1e-300);
+                        r(a.1).total_cmp(&r(b.1))
+                    })
+                    .expect("a model has parts");
                 return Err(SolverError::ElementFailure {
                     element: e,
                     part: self.part_of(e),
                     time: self.time,
                     reason: format!(
                         "run-time mass scaling to {:.3e} s has added {:.2} % of the physical mass \
-                         (limit {:.2} %): the element is collapsing; lower mass_scaling.target_dt, \
+                         (limit {:.2} %); this element needed the largest density scale in this \
+                         step ({scale:.1}x), and part `{}` has taken {:.1} % of its own mass over \
+                         {} elements: elements are collapsing; lower mass_scaling.target_dt, \
                          raise mass_scaling.max_added, or refine the mesh there",
                         ms.target_dt,
                         100.0 * added / phys,
-                        100.0 * ms.max_added
+                        100.0 * ms.max_added,
+                        pm.name,
+                        100.0 * pm.added / pm.physical.max(1e-300),
+                        pm.scaled_elements
                     ),
                 });
             }
