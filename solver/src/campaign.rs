@@ -60,6 +60,7 @@
 //! Run `k` (0-based, in this order) belongs to shard `k mod n` ([`in_shard`]).
 
 use crate::output::atomic::write_atomic;
+use crate::output::filter::{moving_average_at, FORCE_FILTER};
 use crate::output::history::{column, read_history};
 use crate::palpation::{read_probe, ElementChoice, PalpationSetup, Place, TumourSetup};
 use crate::phantom::{location_at, Location, Phantom, PhantomParams};
@@ -780,8 +781,11 @@ pub fn write_done(dir: &Path, m: &DoneMarker) -> Result<(), String> {
 pub struct RunSamples {
     /// Sample times (s).
     pub time: Vec<f64>,
-    /// Hand force along the pressing direction (N).
+    /// Hand force along the pressing direction (N), as probed at the sample time.
     pub force: Vec<f64>,
+    /// The same force filtered: the centred [`FORCE_FILTER`] moving average of the run's
+    /// `history.csv`, at the sample times ([`crate::output::filter`]).
+    pub force_filtered: Vec<f64>,
     /// Indentation since first contact (m): `hand_depth`.
     pub depth: Vec<f64>,
     /// ROI element ids.
@@ -792,7 +796,8 @@ pub struct RunSamples {
     pub tensors: Vec<Vec<[f64; 6]>>,
 }
 
-/// Read the samples of the finished run in `dir` (hand `hand`).
+/// Read the samples of the finished run in `dir` (hand `hand`): `probe.csv`, `probe_stress.csv`
+/// and, for the filtered force, `history.csv`.
 pub fn read_run(dir: &Path) -> Result<RunSamples, String> {
     let hand = "hand";
     let p = read_probe(dir, hand)?;
@@ -803,6 +808,18 @@ pub fn read_run(dir: &Path) -> Result<RunSamples, String> {
             dir.join("probe.csv").display()
         )
     })?;
+    let path = dir.join("history.csv");
+    let (hcols, hrows) = read_history(&path)?;
+    let need = |name: &str| {
+        column(&hcols, &hrows, name)
+            .ok_or_else(|| format!("{}: no column `{name}`", path.display()))
+    };
+    let force_filtered = moving_average_at(
+        &need("time")?,
+        &need(&format!("{hand}_reaction"))?,
+        FORCE_FILTER,
+        &p.time,
+    );
     let path = dir.join("probe_stress.csv");
     let (tcols, trows) = read_history(&path)?;
     if trows.len() != p.time.len() {
@@ -832,6 +849,7 @@ pub fn read_run(dir: &Path) -> Result<RunSamples, String> {
     Ok(RunSamples {
         time: p.time,
         force: p.force,
+        force_filtered,
         depth,
         elements: p.elements,
         max_principal: p.stress,

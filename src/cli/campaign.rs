@@ -12,7 +12,9 @@
 //! - `dataset.npz` + `manifest.json` (also as `dataset.json`, so that both `palpa train DIR` and
 //!   `palpa train DIR/dataset.npz` find it): [`surrogate::Dataset`], written once every run of
 //!   the campaign (or of the shard) is finished. X holds x, y [m], force [N], time [s] and
-//!   depth [m] (indentation since first contact) per sample, Y the ROI maximum principal stress
+//!   depth [m] (indentation since first contact) per sample; the force is the hand reaction
+//!   after the 1 ms centred moving average of [`solver::output::filter`] (the raw probed value
+//!   chatters with the penalty contact and stays in `probe.csv`), Y the ROI maximum principal stress
 //!   [Pa], S the full Cauchy tensors; rows in run order, every sample time of every run.
 //!
 //! Runs execute side by side, `--jobs` at a time, each on its own rayon pool of `--threads`
@@ -586,7 +588,7 @@ fn assemble(
             })?;
         let start = xs.len();
         for k in 0..d.time.len() {
-            xs.push([x, y, d.force[k], d.time[k], d.depth[k]]);
+            xs.push([x, y, d.force_filtered[k], d.time[k], d.depth[k]]);
             ys.extend(cols.iter().map(|&c| d.max_principal[k][c]));
             for &c in &cols {
                 ss.extend(&d.tensors[k][c]);
@@ -614,7 +616,8 @@ fn assemble(
             "version": env!("CARGO_PKG_VERSION"),
             "campaign": plan["title"],
             "settings": plan["settings"],
-            "force": "hand reaction along the pressing direction (hand_reaction)",
+            "force": "hand reaction along the pressing direction (hand_reaction), centred moving average of history.csv at the sample time (contact chatter removed)",
+            "force_filter_s": solver::output::filter::FORCE_FILTER,
             "depth": "indentation since first contact (hand_depth)",
             "x_y": "skin point of the location where the two-finger hand presses",
             "runs": run_rows,

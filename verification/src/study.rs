@@ -29,6 +29,7 @@
 //! cores; the full study runs the paper's 15 mm in 25 ms.
 
 use solver::model::StepTarget;
+use solver::output::filter::{moving_average, FORCE_FILTER};
 use solver::output::history::{column, read_history};
 use solver::palpation::{read_probe, ElementChoice, PalpationSetup, ProbeSamples};
 use solver::phantom::Phantom;
@@ -241,32 +242,6 @@ fn interp(xs: &[f64], ys: &[f64], x: f64) -> f64 {
             ys[i - 1] + w * (ys[i] - ys[i - 1])
         }
     }
-}
-
-/// Width of the centred moving average applied to hand-force histories before they are
-/// compared (s). The penalty contact of a coarse phantom chatters: on the quick profile the hand
-/// force swings between 1 and 65 N from one 12 us history sample to the next while the ROI
-/// stress stays smooth, so the raw RMS difference measures the chatter's phase, not the
-/// force-indentation curve. Crash analysts filter contact forces the same way before comparing
-/// them (SAE J211 channel filtering of LS-DYNA's RCFORC output).
-pub const FORCE_FILTER: f64 = 1e-3;
-
-/// Centred moving average of (t, f) over `width`.
-pub fn moving_average(t: &[f64], f: &[f64], width: f64) -> Vec<f64> {
-    let (mut lo, mut hi, mut sum) = (0usize, 0usize, 0.0);
-    t.iter()
-        .map(|&x| {
-            while hi < t.len() && t[hi] <= x + 0.5 * width {
-                sum += f[hi];
-                hi += 1;
-            }
-            while t[lo] < x - 0.5 * width {
-                sum -= f[lo];
-                lo += 1;
-            }
-            sum / (hi - lo) as f64
-        })
-        .collect()
 }
 
 /// Relative RMS force error of `r` against `reference`, both filtered ([`FORCE_FILTER`]).
@@ -575,29 +550,4 @@ pub fn plots(rows: &[StudyRow], out: &Path) -> Result<Vec<String>, String> {
         files.push(crate::plot::draw(&series, out)?);
     }
     Ok(files)
-}
-
-#[cfg(test)]
-mod tests {
-    use super::moving_average;
-
-    #[test]
-    fn moving_average_keeps_a_ramp_and_removes_chatter() {
-        let t: Vec<f64> = (0..1001).map(|i| i as f64 * 1e-5).collect();
-        // A ramp is reproduced in the interior (a centred average of a linear function; the
-        // width falls between samples so that 50 lie on each side).
-        let ramp: Vec<f64> = t.iter().map(|&x| 3.0 * x).collect();
-        let m = moving_average(&t, &ramp, 1.005e-3);
-        for i in 60..940 {
-            assert!((m[i] - ramp[i]).abs() < 1e-12, "{} vs {}", m[i], ramp[i]);
-        }
-        // Sample-to-sample chatter of +-1 around 2 averages out to within 1/101.
-        let chat: Vec<f64> = (0..t.len())
-            .map(|i| 2.0 + if i % 2 == 0 { 1.0 } else { -1.0 })
-            .collect();
-        let m = moving_average(&t, &chat, 1.005e-3);
-        for v in &m[60..940] {
-            assert!((v - 2.0).abs() <= 1.0 / 101.0 + 1e-12, "{v}");
-        }
-    }
 }

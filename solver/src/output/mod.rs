@@ -3,6 +3,7 @@
 //! directory, then rename), so an interrupted run leaves only complete files.
 
 pub mod atomic;
+pub mod filter;
 pub mod history;
 pub mod stress;
 pub mod vtk;
