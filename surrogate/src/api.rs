@@ -210,7 +210,11 @@ fn fit_and_score(
         }
         ModelKind::Gp => {
             let g = fit_gp(xt.view(), yt.view(), &opts.gp)?;
-            let size = format!("SE-ARD, n={}", g.train_inputs.nrows());
+            let size = format!(
+                "SE-ARD, n={} ({} in the likelihood)",
+                g.train_inputs.nrows(),
+                g.likelihood_rows
+            );
             let (l, np) = (g.log_marginal_likelihood, g.alpha.len());
             let set = serde_json::to_value(&opts.gp).unwrap_or_default();
             (TrainedModel::Gp(g), None, l, size, np, set)
