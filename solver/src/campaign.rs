@@ -887,6 +887,9 @@ mod tests {
         assert_eq!(c.runs[27].label, "C");
         assert_eq!(c.samples_per_run(&c.runs[0]), 6);
         assert_eq!(c.base.voxel, crate::phantom::DEFAULT_VOXEL);
+        // thicker than a single palpation's default (CAMPAIGN_FAT_THICKNESS)
+        assert_eq!(c.base.fat_thickness, 0.025);
+        assert_eq!(PalpationSetup::default().fat_thickness, 0.015);
         assert!(
             (c.runs[0].depth - 0.015).abs() < 1e-15 && (c.runs[0].duration - 0.025).abs() < 1e-15
         );
