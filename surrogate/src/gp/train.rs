@@ -11,8 +11,8 @@
 //! So the hyperparameters maximise the likelihood of the rows whose target row differs from
 //! every earlier row's, the first occurrence kept. On that campaign this is 126 of 150 rows, and
 //! the optimiser lands on length scales 0.99, 0.74, 1.41 (x, y, force) and sn2 = 0.055, held-out
-//! Fit 0.665. The posterior (`alpha`, `K^-1`)
-//! then conditions on every training row with those hyperparameters.
+//! Fit 0.665. The posterior (`alpha`, `K^-1`) then conditions on every training row with those
+//! hyperparameters.
 
 use super::kernel::SeArd;
 use super::likelihood::{compute_factorised, compute_nll_and_gradient, PairwiseSquares};
