@@ -8,8 +8,9 @@
 //!   duplicates no run, does not recompute the finished one (its `done.json` is unchanged) and
 //!   redoes an unfinished run directory from scratch; without `--resume` it refuses to touch
 //!   the finished runs;
-//! - the shipped profiles (scenes/campaign-quick.toml, scenes/campaign-paper.toml) resolve on
-//!   their phantoms (`--dry-run`), and a bad key is an error naming it.
+//! - the shipped profiles (scenes/campaign-quick.toml, scenes/campaign-paper.toml,
+//!   scenes/campaign-fbar-8mm.toml) resolve on their phantoms (`--dry-run`), and a bad key is
+//!   an error naming it.
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
@@ -278,6 +279,15 @@ fn shipped_profiles_resolve_and_bad_keys_are_named() {
         "{paper}"
     );
     assert!(paper.contains("voxel 5.0 mm"), "{paper}");
+    let fbar = ok(&[
+        "campaign",
+        s(&root.join("scenes/campaign-fbar-8mm.toml")),
+        "--dry-run",
+    ]);
+    assert!(
+        fbar.contains("28 runs (28 locations: 25 train, 3 test)") && fbar.contains("voxel 8.0 mm"),
+        "{fbar}"
+    );
 
     let tmp = tempfile::tempdir().unwrap();
     let bad = tmp.path().join("bad.toml");
