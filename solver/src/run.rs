@@ -89,6 +89,17 @@ pub struct RunSummary {
     pub first_eroded: Option<ErodedElement>,
 }
 
+impl RunSummary {
+    /// Mass added by mass scaling over all parts, as a percentage of the physical mass.
+    pub fn added_mass_percent(&self) -> f64 {
+        let (p, a) = self
+            .mass
+            .iter()
+            .fold((0.0, 0.0), |(p, a), m| (p + m.physical_kg, a + m.added_kg));
+        100.0 * a / p.max(1e-300)
+    }
+}
+
 /// An eroded element, for the summary.
 #[derive(Clone, Debug, Serialize)]
 pub struct ErodedElement {

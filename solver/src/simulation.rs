@@ -754,7 +754,7 @@ impl Simulation {
         // Nodes are updated in parallel chunks of fixed size; each chunk's energy sums are
         // reduced serially in chunk order, so the result is the same for any thread count.
         // s: 0 w_int_old 1 w_int_new 2 w_ext_old 3 w_ext_new 4 w_damp_old 5 w_damp_new 6 ke
-        // 7 ke_half 8 res2 9 fint2 10 u.f_int 11 u.M.u
+        // 7 ke_half 8 res2 9 fint2 10 u.f_int 11 u.M.u (10 and 11 only under relaxation)
         let nn = self.u.len();
         let partials = &mut self.scratch_partials;
         partials.clear();
@@ -798,9 +798,11 @@ impl Simulation {
                             s[8] += fnet * fnet;
                         }
                         s[9] += fi * fi;
-                        let u_n = uc[k][d];
-                        s[10] += u_n * fi;
-                        s[11] += m * u_n * u_n;
+                        if relax {
+                            let u_n = uc[k][d];
+                            s[10] += u_n * fi;
+                            s[11] += m * u_n * u_n;
+                        }
                         let h_old = 0.5 * dt_old * v_old;
                         let h_new = 0.5 * dt * v_new;
                         s[0] += fi * h_old;

@@ -451,13 +451,7 @@ pub fn run_contact_scene(scene: &str, tag: &str, name: &str) -> Result<SceneRun,
             steps: summary.steps,
             elements: summary.elements,
             wall: summary.wall_seconds,
-            added_mass_percent: {
-                let (p, a) = summary
-                    .mass
-                    .iter()
-                    .fold((0.0, 0.0), |(p, a), m| (p + m.physical_kg, a + m.added_kg));
-                100.0 * a / p.max(1e-300)
-            },
+            added_mass_percent: summary.added_mass_percent(),
         })
     })();
     let _ = std::fs::remove_dir_all(&dir);

@@ -1,7 +1,7 @@
-//! Quasi-static solutions by palpa's dynamic relaxation (Underwood's adaptive viscous damping): step the explicit
-//! loop with `LoopSettings::relaxation` until the out-of-balance force norm falls below a
-//! tolerance times the internal force norm. Prescribed displacements given as constant curves
-//! are applied in the first step.
+//! Quasi-static solutions by palpa's dynamic relaxation (Underwood's adaptive viscous damping):
+//! step the explicit loop with `LoopSettings::relaxation` until the out-of-balance force norm
+//! falls below a tolerance times the internal force norm. Prescribed displacements given as
+//! constant curves are applied in the first step.
 
 use material::Material;
 use solver::bc::{Constraint, Kinematic, NodalLoad};

@@ -24,12 +24,12 @@
 //! against Hertz's closed form (knobs `hertz mesh`, `hertz element`, ...).
 //!
 //! The study writes `study.csv`, `study.md` and the Pareto plots `pareto_force.png`,
-//! `pareto_stress.png` and `pareto_hertz.png` (error against wall time, one line per knob). `--quick` uses a coarse
-//! phantom and a short indentation (6 mm in 6 ms) so that it finishes in a few minutes on two
+//! `pareto_stress.png` and `pareto_hertz.png` (error against wall time, one line per knob).
+//! `--quick` uses a coarse phantom and a short indentation (6 mm in 6 ms) so that it finishes in a few minutes on two
 //! cores; the full study runs the paper's 15 mm in 25 ms.
 
 use solver::model::StepTarget;
-use solver::output::filter::{moving_average, FORCE_FILTER};
+use solver::output::filter::{moving_average, moving_average_at, FORCE_FILTER};
 use solver::output::history::{column, read_history};
 use solver::palpation::{read_probe, ElementChoice, PalpationSetup, ProbeSamples};
 use solver::phantom::Phantom;
@@ -232,25 +232,13 @@ fn run_one(
     })
 }
 
-/// Linear interpolation of (xs, ys) at x (clamped).
-fn interp(xs: &[f64], ys: &[f64], x: f64) -> f64 {
-    match xs.iter().position(|&t| t >= x) {
-        None => *ys.last().unwrap_or(&0.0),
-        Some(0) => ys[0],
-        Some(i) => {
-            let w = (x - xs[i - 1]) / (xs[i] - xs[i - 1]).max(1e-300);
-            ys[i - 1] + w * (ys[i] - ys[i - 1])
-        }
-    }
-}
-
 /// Relative RMS force error of `r` against `reference`, both filtered ([`FORCE_FILTER`]).
 fn force_error(r: &RunData, reference: &RunData) -> f64 {
     let fr_s = moving_average(&reference.time, &reference.force, FORCE_FILTER);
-    let f_s = moving_average(&r.time, &r.force, FORCE_FILTER);
+    // the run's filtered force at the reference's history times (linear, clamped)
+    let f_s = moving_average_at(&r.time, &r.force, FORCE_FILTER, &reference.time);
     let (mut num, mut den) = (0.0, 0.0);
-    for (t, fr) in reference.time.iter().zip(&fr_s) {
-        let f = interp(&r.time, &f_s, *t);
+    for (f, fr) in f_s.iter().zip(&fr_s) {
         num += (f - fr).powi(2);
         den += fr * fr;
     }
@@ -303,7 +291,7 @@ pub fn run_study(
         ));
         data.push(run_one(&va.setup, &dir, &mut phantoms));
     }
-    let rows = variants
+    let mut rows = variants
         .iter()
         .zip(&data)
         .map(|(va, d)| {
@@ -321,14 +309,7 @@ pub fn run_study(
                     steps: r.summary.steps,
                     element_cycles: r.summary.elements as f64 * r.summary.steps as f64,
                     wall: r.summary.wall_seconds,
-                    added_mass_percent: {
-                        let (p, a) = r
-                            .summary
-                            .mass
-                            .iter()
-                            .fold((0.0, 0.0), |(p, a), m| (p + m.physical_kg, a + m.added_kg));
-                        100.0 * a / p.max(1e-300)
-                    },
+                    added_mass_percent: r.summary.added_mass_percent(),
                     peak_force: r.force.iter().cloned().fold(0.0, f64::max),
                     force_error: force_error(r, reference),
                     stress_error: stress_error(r, reference),
@@ -344,7 +325,6 @@ pub fn run_study(
         })
         .collect::<Vec<_>>();
     let first = variants.len();
-    let mut rows = rows;
     rows.extend(crate::study_hertz::run(quick, |i, what| {
         progress(first + i, n, what)
     }));
