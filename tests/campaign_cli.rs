@@ -298,6 +298,14 @@ fn shipped_profiles_resolve_and_bad_keys_are_named() {
         !o.status.success() && err.contains("depht") && err.contains("bad.toml"),
         "{err}"
     );
+    // a value out of range names the file and the key
+    std::fs::write(&bad, "[phantom]\nfat_thickness = \"-5 mm\"\n").unwrap();
+    let o = palpa(&["campaign", s(&bad), "--dry-run"]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        !o.status.success() && err.contains("bad.toml") && err.contains("fat_thickness"),
+        "{err}"
+    );
     let o = palpa(&["campaign", "--shard", "2/2", "--dry-run"]);
     assert!(!o.status.success());
 }

@@ -144,10 +144,12 @@ fn run_campaign(a: &CampaignArgs) -> Result<(), String> {
         Some(f) => CampaignSpec::load(f)?,
         None => CampaignSpec::default(),
     };
-    let campaign = spec.resolve().map_err(|e| match &a.file {
+    // errors of the file's values name the file
+    let in_file = |e: String| match &a.file {
         Some(f) => format!("{}: {e}", f.display()),
         None => e,
-    })?;
+    };
+    let campaign = spec.resolve().map_err(in_file)?;
     let shard = a.shard.as_deref().map(parse_shard).transpose()?;
     if a.jobs == Some(0) || a.threads == Some(0) {
         return Err("--jobs and --threads must be at least 1".into());
@@ -155,8 +157,9 @@ fn run_campaign(a: &CampaignArgs) -> Result<(), String> {
 
     // The phantom, once for every run.
     let t0 = Instant::now();
-    let params = campaign.phantom_params()?;
-    let phantom = solver::phantom::build(&params)?;
+    let params = campaign.phantom_params().map_err(in_file)?;
+    let phantom =
+        solver::phantom::build(&params).map_err(|e| in_file(format!("[phantom]: {e}")))?;
     let build_s = t0.elapsed().as_secs_f64();
     let locs = campaign.resolve_locations(&phantom)?;
     let plan = campaign.plan_json(&phantom, &locs);

@@ -143,19 +143,19 @@ impl PhantomParams {
     pub fn validate(&self) -> Result<(), String> {
         if !(self.voxel > 0.0005 && self.voxel < 0.05) {
             return Err(format!(
-                "voxel size {} m out of range (0.5 mm .. 50 mm)",
+                "`voxel` = {} m is out of range (0.5 mm .. 50 mm)",
                 self.voxel
             ));
         }
         if !(0.0..=0.05).contains(&self.fat_thickness) {
             return Err(format!(
-                "fat thickness {} m out of range (0 .. 50 mm)",
+                "`fat_thickness` = {} m is out of range (0 .. 50 mm)",
                 self.fat_thickness
             ));
         }
         if !(0.0..=1.0).contains(&self.respiratory_phase) {
             return Err(format!(
-                "respiratory phase {} out of range 0..1",
+                "`respiratory_phase` = {} is out of range (0 .. 1)",
                 self.respiratory_phase
             ));
         }
