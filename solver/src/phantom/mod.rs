@@ -52,7 +52,9 @@ mod params;
 mod roi;
 
 pub use anatomy::{Anatomy, BACKGROUND, FLESH, LIVER, RIBS, SPINE, TUMOUR, VISCERA};
-pub use locations::{cast_down, find_locations, location_at, Location, Locations};
+pub use locations::{
+    cast_down, find_locations, location_at, mean_normal, Location, Locations, NORMAL_RADIUS,
+};
 pub use params::{
     GridParams, PhantomParams, RoiParams, Tumour, Variant, DEFAULT_VOXEL, PAPER_VOXEL,
 };
