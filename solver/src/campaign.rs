@@ -48,6 +48,7 @@
 //!
 //! [solver]
 //! element = "one_point"            # one_point | stiffness | full_fbar
+//! # element_by_part = { liver = "full_fbar" }   # per-part formulations replacing `element`
 //! dt_factor = 0.9
 //! mass_scaling = "initial"         # selective mass scaling: initial (default) | "2 x initial" | "4 us" | "off"
 //! # mass_scaling_limit = 0.05
@@ -219,6 +220,9 @@ pub struct HandSpec {
 pub struct SolverSpec {
     /// `one_point` (default), `stiffness` or `full_fbar`.
     pub element: Option<String>,
+    /// Per-part formulations that replace `element`, e.g. `{ liver = "full_fbar" }` (parts
+    /// flesh, liver, ribs, viscera, spine, tumour, tumour2, ...; tumours follow liver).
+    pub element_by_part: Option<std::collections::BTreeMap<String, String>>,
     /// Time-step safety factor (default 0.75).
     pub dt_factor: Option<Number>,
     /// Selective mass scaling: `"initial"` (the default, as `palpa palpate`), `"<k> x
@@ -458,6 +462,22 @@ impl CampaignSpec {
         if let Some(e) = &sv.element {
             base.element = e.parse::<ElementChoice>()?;
         }
+        for (part, e) in sv.element_by_part.iter().flatten() {
+            let known = ["flesh", "liver", "ribs", "viscera", "spine"].contains(&part.as_str())
+                || part == "tumour"
+                || part
+                    .strip_prefix("tumour")
+                    .is_some_and(|n| n.parse::<usize>().is_ok_and(|n| n >= 2));
+            if !known {
+                return Err(format!(
+                    "solver.element_by_part: unknown part `{part}` (flesh, liver, ribs, viscera, spine, tumour, tumour2, ...)"
+                ));
+            }
+            let choice = e
+                .parse::<ElementChoice>()
+                .map_err(|m| format!("solver.element_by_part.{part}: {m}"))?;
+            base.part_elements.insert(part.clone(), choice);
+        }
         if let Some(f) = sv.dt_factor {
             base.dt_factor = f.0;
         }
@@ -667,7 +687,7 @@ impl Campaign {
     pub fn plan_json(&self, ph: &Phantom, locs: &[Location]) -> serde_json::Value {
         let b = &self.base;
         let p = &ph.params;
-        json!({
+        let mut plan = json!({
             "title": self.title,
             "settings": {
                 "sample_interval_s": b.sample_interval,
@@ -701,7 +721,17 @@ impl Campaign {
                 "duration_s": r.duration,
                 "samples": self.samples_per_run(r),
             })).collect::<Vec<_>>(),
-        })
+        });
+        // only when given, so that the plans of earlier campaigns still match on --resume
+        if !b.part_elements.is_empty() {
+            plan["settings"]["element_by_part"] = b
+                .part_elements
+                .iter()
+                .map(|(k, v)| (k.clone(), json!(v.label())))
+                .collect::<serde_json::Map<_, _>>()
+                .into();
+        }
+        plan
     }
 }
 
@@ -937,6 +967,43 @@ mod tests {
         assert!((c.runs[1].duration - 0.010).abs() < 1e-15);
     }
 
+    /// `element_by_part` sets the liver (and its tumours) apart; the other parts keep
+    /// `element`, and the plan records the override.
+    #[test]
+    fn per_part_elements_reach_the_scene_and_the_plan() {
+        let spec: CampaignSpec = toml::from_str(
+            r#"
+            [phantom]
+            tumours = [{ center = ["-60 mm", "180 mm", "150 mm"], radius = "10 mm", stiffness = 5.0 }]
+            [solver]
+            element = "one_point"
+            element_by_part = { liver = "full_fbar" }
+            "#,
+        )
+        .unwrap();
+        let c = spec.resolve().unwrap();
+        let scene = c.setup(&c.runs[0]).scene_toml();
+        let formulation = |part: &str| {
+            let i = scene.find(&format!("name = \"{part}\"")).unwrap();
+            let rest = &scene[i..];
+            let j = rest.find("formulation = ").unwrap();
+            rest[j..].lines().next().unwrap().to_string()
+        };
+        assert_eq!(formulation("liver"), "formulation = \"full_fbar\"");
+        assert_eq!(formulation("tumour"), "formulation = \"full_fbar\"");
+        assert_eq!(formulation("flesh"), "formulation = \"one_point\"");
+        assert_eq!(formulation("ribs"), "formulation = \"one_point\"");
+        let ph = crate::phantom::build(&PhantomParams {
+            voxel: 0.012,
+            ..c.phantom_params().unwrap()
+        })
+        .unwrap();
+        let plan = c.plan_json(&ph, &[]);
+        assert_eq!(plan["settings"]["element_by_part"]["liver"], "full-fbar");
+        let plain = Campaign::paper().plan_json(&ph, &[]);
+        assert!(plain["settings"].get("element_by_part").is_none());
+    }
+
     #[test]
     fn errors_name_the_problem() {
         let e = toml::from_str::<CampaignSpec>("[indentation]\ndepth = \"5 ms\"\n").unwrap_err();
@@ -947,6 +1014,19 @@ mod tests {
         assert!(spec.resolve().unwrap_err().contains("twice"));
         let spec: CampaignSpec = toml::from_str("[locations]\ntrain = [\"Q9\"]\n").unwrap();
         assert!(spec.resolve().unwrap_err().contains("unknown location"));
+        let spec: CampaignSpec =
+            toml::from_str("[solver]\nelement_by_part = { livers = \"full_fbar\" }\n").unwrap();
+        assert!(spec
+            .resolve()
+            .unwrap_err()
+            .contains("unknown part `livers`"));
+        let spec: CampaignSpec =
+            toml::from_str("[solver]\nelement_by_part = { liver = \"fbar2\" }\n").unwrap();
+        let e = spec.resolve().unwrap_err();
+        assert!(
+            e.contains("element_by_part.liver") && e.contains("fbar2"),
+            "{e}"
+        );
         assert_eq!(parse_shard("1/3").unwrap(), (1, 3));
         assert!(parse_shard("3/3").is_err());
     }

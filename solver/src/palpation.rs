@@ -156,6 +156,10 @@ pub struct PalpationSetup {
     pub finger_spacing: f64,
     /// Element formulation.
     pub element: ElementChoice,
+    /// Per-part formulations that replace `element` (part name to choice): e.g. F-bar in the
+    /// liver, whose element stresses are the ROI's, and one-point elsewhere. Tumour parts
+    /// follow the liver's entry unless they have their own.
+    pub part_elements: std::collections::BTreeMap<String, ElementChoice>,
     /// Selective mass scaling, if any. Default: the initial stable step
     /// ([`StepTarget::Initial`]), so that elements crushed under the fingers do not pull
     /// the step down (about half the steps of an unscaled run, about 1.4 % mass added to the
@@ -186,6 +190,7 @@ impl Default for PalpationSetup {
             finger_diameter: 0.015,
             finger_spacing: 0.020,
             element: ElementChoice::OnePointViscousShear,
+            part_elements: Default::default(),
             mass_scaling: Some(StepTarget::Initial(1.0)),
             mass_scaling_limit: 0.05,
             dt_factor: crate::simulation::DEFAULT_DT_FACTOR,
@@ -304,7 +309,15 @@ impl PalpationSetup {
             s.push_str("]\n");
         }
         s.push('\n');
-        let el = self.element.scene_keys();
+        let el = |part: &str| {
+            let tumour = part.starts_with("tumour");
+            self.part_elements
+                .get(part)
+                .or_else(|| tumour.then(|| self.part_elements.get("liver")).flatten())
+                .unwrap_or(&self.element)
+                .scene_keys()
+                .replace(", ", "\n")
+        };
         let parts = [
             ("flesh", "paper:flesh"),
             ("liver", "paper:liver"),
@@ -325,18 +338,10 @@ impl PalpationSetup {
             let _ = writeln!(s, "[materials.{n}]\n{}", scaled_liver_card(t.stiffness));
         }
         for (p, m) in &parts {
-            let _ = writeln!(
-                s,
-                "[[part]]\nname = {p:?}\nmaterial = {m:?}\n{}\n",
-                el.replace(", ", "\n")
-            );
+            let _ = writeln!(s, "[[part]]\nname = {p:?}\nmaterial = {m:?}\n{}\n", el(p));
         }
         for n in &tumour_names {
-            let _ = writeln!(
-                s,
-                "[[part]]\nname = {n:?}\nmaterial = {n:?}\n{}\n",
-                el.replace(", ", "\n")
-            );
+            let _ = writeln!(s, "[[part]]\nname = {n:?}\nmaterial = {n:?}\n{}\n", el(n));
         }
         s.push_str("[[boundary]]\nnodes = \"back\"\nfix = [\"all\"]\n\n");
         let rollers: &[(&str, &str)] = if self.variant == "full" {

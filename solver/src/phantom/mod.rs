@@ -53,7 +53,7 @@ mod roi;
 
 pub use anatomy::{Anatomy, BACKGROUND, FLESH, LIVER, RIBS, SPINE, TUMOUR, VISCERA};
 pub use locations::{
-    cast_down, find_locations, location_at, mean_normal, Location, Locations, NORMAL_RADIUS,
+    cast_down, find_locations, location_at, skin_fit, Location, Locations, SKIN_FIT_RADIUS,
 };
 pub use params::{
     GridParams, PhantomParams, RoiParams, Tumour, Variant, DEFAULT_VOXEL, PAPER_VOXEL,
