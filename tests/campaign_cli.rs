@@ -291,21 +291,19 @@ fn shipped_profiles_resolve_and_bad_keys_are_named() {
 
     let tmp = tempfile::tempdir().unwrap();
     let bad = tmp.path().join("bad.toml");
-    std::fs::write(&bad, "[indentation]\ndepht = \"5 mm\"\n").unwrap();
-    let o = palpa(&["campaign", s(&bad), "--dry-run"]);
-    let err = String::from_utf8_lossy(&o.stderr);
-    assert!(
-        !o.status.success() && err.contains("depht") && err.contains("bad.toml"),
-        "{err}"
-    );
+    // a campaign file that must fail with an error naming the file and `key`
+    let fails_naming = |text: &str, key: &str| {
+        std::fs::write(&bad, text).unwrap();
+        let o = palpa(&["campaign", s(&bad), "--dry-run"]);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(
+            !o.status.success() && err.contains(key) && err.contains("bad.toml"),
+            "{err}"
+        );
+    };
+    fails_naming("[indentation]\ndepht = \"5 mm\"\n", "depht");
     // a value out of range names the file and the key
-    std::fs::write(&bad, "[phantom]\nfat_thickness = \"-5 mm\"\n").unwrap();
-    let o = palpa(&["campaign", s(&bad), "--dry-run"]);
-    let err = String::from_utf8_lossy(&o.stderr);
-    assert!(
-        !o.status.success() && err.contains("bad.toml") && err.contains("fat_thickness"),
-        "{err}"
-    );
+    fails_naming("[phantom]\nfat_thickness = \"-5 mm\"\n", "fat_thickness");
     let o = palpa(&["campaign", "--shard", "2/2", "--dry-run"]);
     assert!(!o.status.success());
 }

@@ -463,11 +463,8 @@ impl CampaignSpec {
             base.element = e.parse::<ElementChoice>()?;
         }
         for (part, e) in sv.element_by_part.iter().flatten() {
-            let known = ["flesh", "liver", "ribs", "viscera", "spine"].contains(&part.as_str())
-                || part == "tumour"
-                || part
-                    .strip_prefix("tumour")
-                    .is_some_and(|n| n.parse::<usize>().is_ok_and(|n| n >= 2));
+            let known = crate::phantom::PART_NAMES.contains(&part.as_str())
+                || crate::phantom::is_tumour_part(part);
             if !known {
                 return Err(format!(
                     "solver.element_by_part: unknown part `{part}` (flesh, liver, ribs, viscera, spine, tumour, tumour2, ...)"

@@ -310,7 +310,7 @@ impl PalpationSetup {
         }
         s.push('\n');
         let el = |part: &str| {
-            let tumour = part.starts_with("tumour");
+            let tumour = crate::phantom::is_tumour_part(part);
             self.part_elements
                 .get(part)
                 .or_else(|| tumour.then(|| self.part_elements.get("liver")).flatten())
@@ -326,13 +326,7 @@ impl PalpationSetup {
             ("spine", "paper:ribs"),
         ];
         let tumour_names: Vec<String> = (0..self.tumours.len())
-            .map(|n| {
-                if n == 0 {
-                    "tumour".into()
-                } else {
-                    format!("tumour{}", n + 1)
-                }
-            })
+            .map(crate::phantom::tumour_part_name)
             .collect();
         for (n, t) in tumour_names.iter().zip(&self.tumours) {
             let _ = writeln!(s, "[materials.{n}]\n{}", scaled_liver_card(t.stiffness));

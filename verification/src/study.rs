@@ -25,8 +25,8 @@
 //!
 //! The study writes `study.csv`, `study.md` and the Pareto plots `pareto_force.png`,
 //! `pareto_stress.png` and `pareto_hertz.png` (error against wall time, one line per knob).
-//! `--quick` uses a coarse phantom and a short indentation (6 mm in 6 ms) so that it finishes in a few minutes on two
-//! cores; the full study runs the paper's 15 mm in 25 ms.
+//! `--quick` uses a coarse phantom and a short indentation (6 mm in 6 ms) so that it finishes
+//! in a few minutes on two cores; the full study runs the paper's 15 mm in 25 ms.
 
 use solver::model::StepTarget;
 use solver::output::filter::{moving_average, moving_average_at, FORCE_FILTER};

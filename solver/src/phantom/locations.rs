@@ -18,8 +18,9 @@
 //! phantom: two locations 2.5 mm apart had been pressed in directions 40 degrees apart, with
 //! reaction forces of 35 and 46 N at the end of the press (1 ms averages).
 //!
-//! What lies under a location is read from the voxel column below it (walking down from the skin): the depth of the first liver
-//! voxel below the skin, whether a rib voxel comes first, and how thick the liver is there.
+//! What lies under a location is read from the voxel column below it (walking down from the
+//! skin): the depth of the first liver voxel below the skin, whether a rib voxel comes first,
+//! and how thick the liver is there.
 //!
 //! The raster is visited row by row from the cranial row to the caudal one, each row from
 //! the patient's right (x min) to the left, like the paper's top-left-to-bottom-right order.

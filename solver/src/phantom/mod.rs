@@ -89,21 +89,37 @@ pub struct Phantom {
     pub tumours: Vec<(String, f64)>,
 }
 
+/// The phantom's part names, labels 1..5 (tumours come after, see [`tumour_part_name`]).
+pub const PART_NAMES: [&str; 5] = ["flesh", "liver", "ribs", "viscera", "spine"];
+
+/// Part name of the phantom's n-th tumour (0-based): "tumour", "tumour2", "tumour3", ...
+pub fn tumour_part_name(n: usize) -> String {
+    if n == 0 {
+        "tumour".to_string()
+    } else {
+        format!("tumour{}", n + 1)
+    }
+}
+
+/// Whether `name` is a tumour part's name ([`tumour_part_name`] of some n).
+pub fn is_tumour_part(name: &str) -> bool {
+    name == "tumour"
+        || name
+            .strip_prefix("tumour")
+            .is_some_and(|n| n.parse::<usize>().is_ok_and(|n| n >= 2))
+}
+
 /// Label map of the phantom.
 pub fn label_map(p: &PhantomParams) -> LabelMap {
-    let mut m = LabelMap::new()
-        .with(FLESH, "flesh")
-        .with(LIVER, "liver")
-        .with(RIBS, "ribs")
-        .with(VISCERA, "viscera")
-        .with(SPINE, "spine");
+    let mut m = LabelMap::new();
+    for (label, name) in [FLESH, LIVER, RIBS, VISCERA, SPINE]
+        .into_iter()
+        .zip(PART_NAMES)
+    {
+        m = m.with(label, name);
+    }
     for n in 0..p.tumours.len() {
-        let name = if n == 0 {
-            "tumour".to_string()
-        } else {
-            format!("tumour{}", n + 1)
-        };
-        m = m.with(TUMOUR + n as u8, &name);
+        m = m.with(TUMOUR + n as u8, &tumour_part_name(n));
     }
     m
 }
@@ -261,16 +277,7 @@ pub fn build(p: &PhantomParams) -> Result<Phantom, String> {
         .tumours
         .iter()
         .enumerate()
-        .map(|(n, t)| {
-            (
-                if n == 0 {
-                    "tumour".to_string()
-                } else {
-                    format!("tumour{}", n + 1)
-                },
-                t.stiffness_factor,
-            )
-        })
+        .map(|(n, t)| (tumour_part_name(n), t.stiffness_factor))
         .collect();
     Ok(Phantom {
         params: p.clone(),
