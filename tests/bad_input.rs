@@ -2,7 +2,7 @@
 //! and no panic (issue 2): malformed TOML, unknown key, unknown unit, negative modulus,
 //! inverted element, missing file.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::Command;
 
 const GOOD: &str = r#"
@@ -26,11 +26,12 @@ nodes = "zmin"
 fix = ["all"]
 "#;
 
-fn dir(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("palpa-bad-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
+/// A fresh temporary directory, removed when the returned guard drops.
+fn dir(name: &str) -> tempfile::TempDir {
+    tempfile::Builder::new()
+        .prefix(&format!("palpa-bad-{name}-"))
+        .tempdir()
+        .unwrap()
 }
 
 /// Run `palpa check FILE` and return (exit ok?, stderr).
@@ -46,7 +47,8 @@ fn check(path: &Path) -> (bool, String) {
 }
 
 fn bad(name: &str, scene: &str, expect: &[&str]) {
-    let d = dir(name);
+    let tmp = dir(name);
+    let d = tmp.path();
     let p = d.join(format!("{name}.toml"));
     std::fs::write(&p, scene).unwrap();
     let (ok, err) = check(&p);
@@ -62,7 +64,8 @@ fn bad(name: &str, scene: &str, expect: &[&str]) {
 
 #[test]
 fn good_scene_passes() {
-    let d = dir("good");
+    let tmp = dir("good");
+    let d = tmp.path();
     let p = d.join("good.toml");
     std::fs::write(&p, GOOD).unwrap();
     let (ok, err) = check(&p);
@@ -131,7 +134,8 @@ fn unknown_node_set_and_material() {
 
 #[test]
 fn missing_files() {
-    let d = dir("missing");
+    let tmp = dir("missing");
+    let d = tmp.path();
     let (ok, err) = check(&d.join("nope.toml"));
     assert!(
         !ok && err.contains("nope.toml") && err.contains("cannot read"),
@@ -146,7 +150,8 @@ fn missing_files() {
 
 #[test]
 fn inverted_element_is_named() {
-    let d = dir("inverted");
+    let tmp = dir("inverted");
+    let d = tmp.path();
     let mut mesh = solver::generate::box_mesh(
         &solver::generate::BoxSpec {
             size: [0.01; 3],

@@ -2,18 +2,19 @@
 //! driver's CSV, its error for a missing file, a coarse reduced phantom, and a NIfTI round
 //! trip (phantom labels out, `mesh image` back in, same mesh).
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::{Command, Output};
 
 fn root() -> &'static Path {
     Path::new(env!("CARGO_MANIFEST_DIR"))
 }
 
-fn dir(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("palpa-cli-mm-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
+/// A fresh temporary directory, removed when the returned guard drops.
+fn dir(name: &str) -> tempfile::TempDir {
+    tempfile::Builder::new()
+        .prefix(&format!("palpa-cli-mm-{name}-"))
+        .tempdir()
+        .unwrap()
 }
 
 fn palpa(args: &[&str]) -> Output {
@@ -61,7 +62,8 @@ fn material_driver_writes_finite_csv() {
     assert!((max - 1.3).abs() < 1e-9 && (rows.last().unwrap()[s] - 1.0).abs() < 1e-9);
 
     // --out writes the same table to a file
-    let d = dir("material-out");
+    let tmp = dir("material-out");
+    let d = tmp.path();
     let f = d.join("liver.csv");
     ok(&[
         "material",
@@ -79,7 +81,8 @@ fn material_errors_name_the_file() {
     let err = String::from_utf8_lossy(&out.stderr);
     assert!(err.contains("no/such/driver.toml"), "{err}");
 
-    let d = dir("material-bad");
+    let tmp = dir("material-bad");
+    let d = tmp.path();
     let f = d.join("typo.toml");
     std::fs::write(
         &f,
@@ -132,7 +135,8 @@ fn min_scaled_jacobian(report: &str) -> f64 {
 
 #[test]
 fn coarse_reduced_phantom_mesh() {
-    let d = dir("phantom");
+    let tmp = dir("phantom");
+    let d = tmp.path();
     let vtu = d.join("phantom.vtu");
     let r = ok(&[
         "mesh",
@@ -160,7 +164,8 @@ fn coarse_reduced_phantom_mesh() {
 
 #[test]
 fn nifti_round_trip_gives_the_same_mesh() {
-    let d = dir("nifti");
+    let tmp = dir("nifti");
+    let d = tmp.path();
     let (direct, nii, again) = (d.join("direct.vtu"), d.join("x.nii.gz"), d.join("y.vtu"));
     let map = d.join("map.toml");
     std::fs::write(
@@ -218,7 +223,8 @@ fn nifti_round_trip_gives_the_same_mesh() {
 /// upward-facing outer face.
 #[test]
 fn reduced_phantom_at_10mm() {
-    let d = dir("phantom10");
+    let tmp = dir("phantom10");
+    let d = tmp.path();
     ok(&[
         "mesh",
         "phantom",

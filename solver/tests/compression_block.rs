@@ -37,7 +37,7 @@ fn check(formulation: &str) {
             .replace("hourglass_coefficient = 0.1", "")
     };
     let tmp = common::tmp_dir(&format!("cb-{formulation}"));
-    let scene_path = tmp.join("scene.toml");
+    let scene_path = tmp.path().join("scene.toml");
     std::fs::write(&scene_path, src).unwrap();
     let mut scene = load_scene(&scene_path).unwrap();
     let (cols, rows) = common::run_to_end(&mut scene, &format!("cb-run-{formulation}"));

@@ -55,10 +55,9 @@ reactions = ["zmax"]
 fn failed_element_is_eroded_and_the_bar_lets_go() {
     let mut scene = common::scene_from_str(SCENE);
     let out = common::tmp_dir("erosion");
-    let (summary, err) = run_scene(&mut scene, &out, &AtomicBool::new(false), |_| {});
+    let (summary, err) = run_scene(&mut scene, out.path(), &AtomicBool::new(false), |_| {});
     assert!(err.is_none(), "run failed: {err:?}");
-    let (cols, rows) = read_history(&out.join("history.csv")).unwrap();
-    let _ = std::fs::remove_dir_all(&out);
+    let (cols, rows) = read_history(&out.path().join("history.csv")).unwrap();
     let t = column(&cols, &rows, "time").unwrap();
     let rz = column(&cols, &rows, "zmax_reaction_z").unwrap();
     let err = column(&cols, &rows, "energy_error").unwrap();

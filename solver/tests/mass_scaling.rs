@@ -174,7 +174,7 @@ fn run_time_scaling_holds_the_target_step_of_a_crushed_block() {
     let out = common::tmp_dir("ms-tight");
     let (_, err) = solver::run::run_scene(
         &mut tight,
-        &out,
+        out.path(),
         &std::sync::atomic::AtomicBool::new(false),
         |_| {},
     );
@@ -184,7 +184,6 @@ fn run_time_scaling_holds_the_target_step_of_a_crushed_block() {
         msg.contains("element") && msg.contains("run-time mass scaling") && msg.contains("limit"),
         "{msg}"
     );
-    let _ = std::fs::remove_dir_all(&out);
 }
 
 #[test]

@@ -55,7 +55,7 @@ fn hourglass_guard_names_the_element_and_the_time() {
     // Without the guard: the run ends, with hourglass energy far above 10 % of internal.
     let mut free = common::scene_from_str(&finger_scene(""));
     let out = common::tmp_dir("hg-free");
-    let (summary, err) = run_scene(&mut free, &out, &AtomicBool::new(false), |_| {});
+    let (summary, err) = run_scene(&mut free, out.path(), &AtomicBool::new(false), |_| {});
     assert!(err.is_none(), "unguarded run failed: {err:?}");
     let ratio = summary.hourglass_energy / summary.internal_energy;
     assert!(
@@ -65,7 +65,7 @@ fn hourglass_guard_names_the_element_and_the_time() {
 
     let mut guarded = common::scene_from_str(&finger_scene("max_hourglass_ratio = 0.1"));
     let out2 = common::tmp_dir("hg-guard");
-    let (summary, err) = run_scene(&mut guarded, &out2, &AtomicBool::new(false), |_| {});
+    let (summary, err) = run_scene(&mut guarded, out2.path(), &AtomicBool::new(false), |_| {});
     let err = err.expect("the guard must stop the run");
     assert!(err.contains("hourglass energy is"), "{err}");
     assert!(
@@ -75,8 +75,6 @@ fn hourglass_guard_names_the_element_and_the_time() {
     assert!(summary.time < 4e-3, "stopped at {} s", summary.time);
     // Checked only after 10 % of the end time by default.
     assert!(summary.time >= 0.4e-3, "stopped at {} s", summary.time);
-    let _ = std::fs::remove_dir_all(out);
-    let _ = std::fs::remove_dir_all(out2);
 }
 
 #[test]

@@ -4,7 +4,7 @@
 use solver::run::run_scene;
 use solver::scene::build::build_scene;
 use solver::scene::{Scene, SceneSpec};
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::sync::atomic::AtomicBool;
 
 /// Parse a scene from text (relative paths resolve against the crate directory).
@@ -20,20 +20,20 @@ pub fn scene_from_str(src: &str) -> Scene {
     .expect("scene builds")
 }
 
-/// A fresh temporary output directory.
-pub fn tmp_dir(name: &str) -> PathBuf {
-    let d = std::env::temp_dir().join(format!("palpa-test-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&d);
-    std::fs::create_dir_all(&d).unwrap();
-    d
+/// A fresh temporary output directory, removed when the returned guard drops.
+pub fn tmp_dir(name: &str) -> tempfile::TempDir {
+    tempfile::Builder::new()
+        .prefix(&format!("palpa-test-{name}-"))
+        .tempdir()
+        .unwrap()
 }
 
 /// Run a scene to its end and return the history (columns, rows).
 pub fn run_to_end(scene: &mut Scene, name: &str) -> (Vec<String>, Vec<Vec<f64>>) {
-    let out = tmp_dir(name);
-    let (summary, err) = run_scene(scene, &out, &AtomicBool::new(false), |_| {});
+    let tmp = tmp_dir(name);
+    let out = tmp.path();
+    let (summary, err) = run_scene(scene, out, &AtomicBool::new(false), |_| {});
     assert!(err.is_none(), "run failed: {err:?} ({})", summary.status);
     let h = solver::output::history::read_history(&out.join("history.csv")).unwrap();
-    let _ = std::fs::remove_dir_all(&out);
     h
 }
