@@ -288,6 +288,29 @@ fn shipped_profiles_resolve_and_bad_keys_are_named() {
         fbar.contains("28 runs (28 locations: 25 train, 3 test)") && fbar.contains("voxel 8.0 mm"),
         "{fbar}"
     );
+    // the ROI-fitted raster: rows 15 mm apart from y = 225 to 165 mm, with the default A, B, C
+    let roi = ok(&[
+        "campaign",
+        s(&root.join("scenes/campaign-roi-raster.toml")),
+        "--dry-run",
+    ]);
+    assert!(
+        roi.contains("28 runs (28 locations: 25 train, 3 test)"),
+        "{roi}"
+    );
+    for row in ["R01 ", "R25 "] {
+        assert!(roi.contains(row), "{roi}");
+    }
+    let ys: Vec<f64> = roi
+        .lines()
+        .filter(|l| l.trim_start().starts_with('R'))
+        .filter_map(|l| l.split_whitespace().nth(4)?.parse().ok())
+        .collect();
+    assert_eq!(ys.len(), 25, "{roi}");
+    assert!(
+        (ys[0] - 225.0).abs() < 1e-9 && (ys[24] - 165.0).abs() < 1e-9,
+        "{ys:?}"
+    );
 
     let tmp = tempfile::tempdir().unwrap();
     let bad = tmp.path().join("bad.toml");

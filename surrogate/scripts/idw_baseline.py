@@ -5,7 +5,13 @@
   should beat.
 - Oracle: the best least-squares blend of those 4 neighbours' fields, with weights fitted per
   time stamp to the test location's own answer. No model that blends neighbouring fields can
-  do better. It shows how much of the test field the raster resolves at all.
+  do better. It shows how much of the test field the raster resolves at all. The same oracle
+  over the 9 nearest and over all training locations is printed too (a GP with one shared
+  kernel predicts a blend of training fields, so the all-locations oracle bounds it from above
+  at each time stamp).
+- Neighbour means (when the training locations form a full raster): the mean of the two
+  raster neighbours predicting the point between them, along x and along y. It measures how
+  much the field changes over one raster spacing.
 
     python surrogate/scripts/idw_baseline.py CAMPAIGN_DIR   (needs numpy)
 """
@@ -45,6 +51,43 @@ def main(d):
         all_o.append(oracle)
     y = np.vstack(all_y)
     print(f"all test samples: IDW Fit {fit(y, np.vstack(all_p)):.3f}, oracle {fit(y, np.vstack(all_o)):.3f}")
+    for k in sorted({min(9, len(train)), len(train)} - {4}):
+        oy = []
+        for t in test:
+            near = sorted(train, key=lambda g: np.linalg.norm(xy[g] - xy[t]))[:k]
+            for s in range(len(ys[t])):
+                a = np.stack([ys[g][s] for g in near], 1)
+                c, *_ = np.linalg.lstsq(a, ys[t][s], rcond=None)
+                oy.append(a @ c)
+        print(f"all test samples: oracle over the {k} nearest training locations {fit(y, np.array(oy)):.3f}")
+    neighbour_means(train, xy, ys)
+
+
+def neighbour_means(train, xy, ys):
+    """Mean of the two raster neighbours against the point between them, along x and y."""
+    xs = sorted({round(float(xy[g][0]), 6) for g in train})
+    ys_ = sorted({round(float(xy[g][1]), 6) for g in train})
+    at = {(round(float(xy[g][0]), 6), round(float(xy[g][1]), 6)): g for g in train}
+    if len(at) != len(xs) * len(ys_) or len(xs) < 3 or len(ys_) < 3:
+        return
+    for axis, name in ((0, "x"), (1, "y")):
+        t, p = [], []  # per location: samples x elements
+        for i, xv in enumerate(xs):
+            for j, yv in enumerate(ys_):
+                if (axis == 0 and 0 < i < len(xs) - 1) or (axis == 1 and 0 < j < len(ys_) - 1):
+                    lo = (xs[i - 1], yv) if axis == 0 else (xv, ys_[j - 1])
+                    hi = (xs[i + 1], yv) if axis == 0 else (xv, ys_[j + 1])
+                    t.append(ys[at[(xv, yv)]])
+                    p.append(0.5 * (ys[at[lo]] + ys[at[hi]]))
+        step = (xs[1] - xs[0]) if axis == 0 else (ys_[1] - ys_[0])
+        per_sample = ", ".join(
+            f"{fit(np.array([a[k] for a in t]), np.array([b[k] for b in p])):.2f}"
+            for k in range(1, len(t[0]))
+        )
+        print(
+            f"raster neighbour mean along {name} (+-{step * 1e3:.1f} mm): Fit "
+            f"{fit(np.vstack(t), np.vstack(p)):.3f}; each time stamp after the first alone: {per_sample}"
+        )
 
 
 if __name__ == "__main__":

@@ -1,0 +1,181 @@
+"""Probes of surrogate model classes on a campaign's dataset, scored by held-out Fit (paper eq. 5).
+
+These are the numpy / scikit-learn prototypes behind the README's "what I measured" list. None of
+them is a palpa model; each asks whether a different model class would lift the held-out Fit
+above what `palpa train` gives on the same data.
+
+- gp: a GP with one kernel shared by all outputs, as `palpa train --model gp` (inputs z-scored,
+  outputs centred per element and scaled by one pooled deviation; hyperparameters by marginal
+  likelihood over the rows with distinct targets, then conditioned on all rows), with the
+  squared-exponential kernel and Matern 5/2, 3/2 and 1/2 kernels (ARD, plus white noise).
+- gp-lolo: the same kernels with hyperparameters chosen by leave-one-location-out error on the
+  training locations (Rasmussen & Williams 2006, sec. 5.4.2) instead of marginal likelihood.
+- pointwise: one MLP (scikit-learn, 3 hidden layers) over every (sample, ROI element) pair, with
+  inputs finger x, y, force, the element's centroid and its plan offset from the fingers, so
+  that it can learn a stress pattern that moves with the hand.
+- shift: inverse-distance weighting of the 4 nearest training fields, each first shifted in plan
+  by a fraction alpha of the offset between its hand and the test hand (alpha 0 = plain IDW),
+  the shifted field read off with a 4 mm Gaussian kernel over the ROI centroids.
+
+    python surrogate/scripts/model_probes.py CAMPAIGN_DIR [gp] [gp-lolo] [pointwise] [shift]
+    (needs numpy, scipy and scikit-learn; the pointwise probe takes a few minutes)
+"""
+import sys
+import warnings
+
+import numpy as np
+
+warnings.filterwarnings("ignore")
+
+
+def fit(y, yhat):
+    return 1.0 - np.sqrt(((y - yhat) ** 2).sum() / ((y - y.mean()) ** 2).sum())
+
+
+class Data:
+    def __init__(self, d):
+        z = np.load(f"{d}/dataset.npz")
+        self.x, self.y = z["X"][:, :3], z["Y"]
+        self.loc, self.split, self.c = z["location"], z["split"], z["roi_centroids"]
+        self.tr, self.te = self.split == 0, self.split != 0
+        self.mu, self.sd = self.x[self.tr].mean(0), self.x[self.tr].std(0)
+        self.u = (self.x - self.mu) / self.sd
+        self.ym = self.y[self.tr].mean(0)
+        self.s = np.sqrt(self.y[self.tr].var(0).mean())
+        self.v = (self.y - self.ym) / self.s
+
+    def report(self, name, pred):
+        t = self.y[self.te]
+        lt = self.loc[self.te]
+        per = " / ".join(f"{fit(t[lt == l], pred[lt == l]):.3f}" for l in np.unique(lt))
+        print(f"{name}: held-out Fit {fit(t, pred):.3f} (per location {per})", flush=True)
+
+
+def kernels():
+    from sklearn.gaussian_process.kernels import RBF, ConstantKernel, Matern, WhiteKernel
+
+    noise = WhiteKernel(1e-2, (1e-8, 10.0))
+    return {
+        "SE": ConstantKernel(1.0) * RBF([1.0] * 3, (1e-2, 1e2)) + noise,
+        "Matern 5/2": ConstantKernel(1.0) * Matern([1.0] * 3, (1e-2, 1e2), nu=2.5) + noise,
+        "Matern 3/2": ConstantKernel(1.0) * Matern([1.0] * 3, (1e-2, 1e2), nu=1.5) + noise,
+        "Matern 1/2": ConstantKernel(1.0) * Matern([1.0] * 3, (1e-2, 1e2), nu=0.5) + noise,
+    }
+
+
+def probe_gp(d):
+    from sklearn.gaussian_process import GaussianProcessRegressor as Gpr
+
+    u, v = d.u[d.tr], d.v[d.tr]
+    _, first = np.unique(np.round(v, 12), axis=0, return_index=True)
+    first = np.sort(first)
+    for name, k in kernels().items():
+        g = Gpr(k, n_restarts_optimizer=2, random_state=0).fit(u[first], v[first])
+        g = Gpr(g.kernel_, optimizer=None).fit(u, v)
+        d.report(f"GP {name}, marginal likelihood ({g.kernel_})", g.predict(d.u[d.te]) * d.s + d.ym)
+
+
+def probe_gp_lolo(d):
+    from scipy.optimize import minimize
+
+    u, v, loc = d.u[d.tr], d.v[d.tr], d.loc[d.tr]
+
+    def kern(a, b, ls, nu):
+        r2 = (((a[:, None, :] - b[None, :, :]) / ls) ** 2).sum(-1)
+        if nu is None:
+            return np.exp(-0.5 * r2)
+        r = np.sqrt(r2)
+        if nu == 1.5:
+            return (1 + np.sqrt(3) * r) * np.exp(-np.sqrt(3) * r)
+        return (1 + np.sqrt(5) * r + 5 / 3 * r2) * np.exp(-np.sqrt(5) * r)
+
+    def predict(ua, va, ub, th, nu):
+        ls, sn = np.exp(th[:3]), np.exp(th[3])
+        k = kern(ua, ua, ls, nu) + sn * np.eye(len(ua))
+        return kern(ub, ua, ls, nu) @ np.linalg.solve(k, va)
+
+    def lolo(th, nu):
+        sse = 0.0
+        for l in np.unique(loc):
+            m = loc == l
+            sse += ((predict(u[~m], v[~m], u[m], th, nu) - v[m]) ** 2).sum()
+        return sse
+
+    for name, nu in (("SE", None), ("Matern 5/2", 2.5), ("Matern 3/2", 1.5)):
+        best = None
+        for l0 in (0.5, 1.0, 2.0):
+            th0 = np.array([np.log(l0)] * 3 + [np.log(0.03)])
+            r = minimize(lambda t: lolo(t, nu), th0, method="Nelder-Mead",
+                         options={"maxiter": 300, "xatol": 1e-3, "fatol": 1e-6})
+            if best is None or r.fun < best.fun:
+                best = r
+        th = best.x
+        ls = ", ".join(f"{x:.2f}" for x in np.exp(th[:3]))
+        d.report(f"GP {name}, leave-one-location-out hyperparameters (lengths {ls}, noise {np.exp(th[3]):.4f})",
+                 predict(u, v, d.u[d.te], th, nu) * d.s + d.ym)
+
+
+def probe_pointwise(d):
+    from sklearn.neural_network import MLPRegressor
+
+    def rows(mask):
+        h = d.x[mask]
+        n, r = len(h), len(d.c)
+        hh = np.repeat(h, r, 0)
+        e = np.tile(d.c, (n, 1))
+        f = np.column_stack([hh, e, e[:, 0] - hh[:, 0], e[:, 1] - hh[:, 1]])
+        return f, d.y[mask].reshape(-1)
+
+    ftr, ytr = rows(d.tr)
+    fte, _ = rows(d.te)
+    mu, sd, ys = ftr.mean(0), ftr.std(0), ytr.std()
+    for hidden in ((128, 128, 128), (256, 256, 256)):
+        m = MLPRegressor(hidden_layer_sizes=hidden, max_iter=200, batch_size=256,
+                         learning_rate_init=1e-3, random_state=0, alpha=1e-5)
+        m.fit((ftr - mu) / sd, ytr / ys)
+        pred = (m.predict((fte - mu) / sd) * ys).reshape(d.te.sum(), -1)
+        d.report(f"pointwise MLP {hidden}", pred)
+
+
+def probe_shift(d):
+    from scipy.spatial import cKDTree
+
+    tree = cKDTree(d.c)
+    locs = np.unique(d.loc)
+    hand = {l: d.x[d.loc == l][0, :2] for l in locs}
+    field = {l: d.y[d.loc == l] for l in locs}
+    train = [l for l in locs if d.split[d.loc == l][0] == 0]
+    test = [l for l in locs if d.split[d.loc == l][0] != 0]
+
+    def shifted(f, delta, alpha, h=0.004):
+        q = d.c.copy()
+        q[:, :2] -= alpha * delta
+        out = f.copy()
+        for e, ix in enumerate(tree.query_ball_point(q, r=2.5 * h)):
+            if ix:
+                w = np.exp(-((d.c[ix] - q[e]) ** 2).sum(1) / h**2)
+                out[:, e] = f[:, ix] @ w / w.sum()
+        return out
+
+    for alpha in (0.0, 0.5, 1.0):
+        pred = []
+        for l in test:
+            dist = np.array([np.linalg.norm(hand[g] - hand[l]) for g in train])
+            near = np.argsort(dist)[:4]
+            w = 1.0 / np.maximum(dist[near], 1e-9) ** 2
+            w /= w.sum()
+            pred.append(sum(wi * shifted(field[train[n]], hand[l] - hand[train[n]], alpha)
+                            for wi, n in zip(w, near)))
+        d.report(f"IDW of 4 fields shifted by {alpha:.1f} x the hand offset", np.vstack(pred))
+
+
+def main(argv):
+    d = Data(argv[0])
+    probes = argv[1:] or ["gp", "gp-lolo", "shift"]
+    table = {"gp": probe_gp, "gp-lolo": probe_gp_lolo, "pointwise": probe_pointwise, "shift": probe_shift}
+    for p in probes:
+        table[p](d)
+
+
+if __name__ == "__main__":
+    main(sys.argv[1:])
