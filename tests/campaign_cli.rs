@@ -259,41 +259,27 @@ fn killed_campaign_resumes_without_losing_or_repeating_runs() {
 #[test]
 fn shipped_profiles_resolve_and_bad_keys_are_named() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
-    let quick = ok(&[
-        "campaign",
-        s(&root.join("scenes/campaign-quick.toml")),
-        "--dry-run",
-    ]);
+    // `palpa campaign scenes/NAME --dry-run`: the plan's table
+    let dry_run = |name: &str| ok(&["campaign", s(&root.join("scenes").join(name)), "--dry-run"]);
+    let quick = dry_run("campaign-quick.toml");
     assert!(
         quick.contains("5 runs (5 locations: 4 train, 1 test)"),
         "{quick}"
     );
     assert_eq!(quick.matches("to run").count(), 5, "{quick}");
-    let paper = ok(&[
-        "campaign",
-        s(&root.join("scenes/campaign-paper.toml")),
-        "--dry-run",
-    ]);
+    let paper = dry_run("campaign-paper.toml");
     assert!(
         paper.contains("28 runs (28 locations: 25 train, 3 test)"),
         "{paper}"
     );
     assert!(paper.contains("voxel 5.0 mm"), "{paper}");
-    let fbar = ok(&[
-        "campaign",
-        s(&root.join("scenes/campaign-fbar-8mm.toml")),
-        "--dry-run",
-    ]);
+    let fbar = dry_run("campaign-fbar-8mm.toml");
     assert!(
         fbar.contains("28 runs (28 locations: 25 train, 3 test)") && fbar.contains("voxel 8.0 mm"),
         "{fbar}"
     );
     // the ROI-fitted raster: rows 15 mm apart from y = 225 to 165 mm, with the default A, B, C
-    let roi = ok(&[
-        "campaign",
-        s(&root.join("scenes/campaign-roi-raster.toml")),
-        "--dry-run",
-    ]);
+    let roi = dry_run("campaign-roi-raster.toml");
     assert!(
         roi.contains("28 runs (28 locations: 25 train, 3 test)"),
         "{roi}"

@@ -467,7 +467,8 @@ impl CampaignSpec {
                 || crate::phantom::is_tumour_part(part);
             if !known {
                 return Err(format!(
-                    "solver.element_by_part: unknown part `{part}` (flesh, liver, ribs, viscera, spine, tumour, tumour2, ...)"
+                    "solver.element_by_part: unknown part `{part}` ({}, tumour, tumour2, ...)",
+                    crate::phantom::PART_NAMES.join(", ")
                 ));
             }
             let choice = e

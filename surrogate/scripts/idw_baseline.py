@@ -25,6 +25,16 @@ def fit(y, yhat):
     return 1.0 - np.sqrt(((y - yhat) ** 2).sum() / ((y - y.mean()) ** 2).sum())
 
 
+def best_blend(ys, near, t):
+    """Least-squares blend of the fields of `near` fitted to location t's field, per time stamp."""
+    out = []
+    for k in range(len(ys[t])):
+        a = np.stack([ys[g][k] for g in near], 1)
+        c, *_ = np.linalg.lstsq(a, ys[t][k], rcond=None)
+        out.append(a @ c)
+    return np.array(out)
+
+
 def main(d):
     data = np.load(f"{d}/dataset.npz")
     labels = json.load(open(f"{d}/dataset.json"))["location_labels"]
@@ -39,12 +49,7 @@ def main(d):
         w = np.array([1.0 / max(np.linalg.norm(xy[g] - xy[t]), 1e-9) for g in near])
         w /= w.sum()
         pred = sum(wi * ys[g] for wi, g in zip(w, near))
-        oracle = []
-        for k in range(len(ys[t])):
-            a = np.stack([ys[g][k] for g in near], 1)
-            c, *_ = np.linalg.lstsq(a, ys[t][k], rcond=None)
-            oracle.append(a @ c)
-        oracle = np.array(oracle)
+        oracle = best_blend(ys, near, t)
         print(f"{t}: neighbours {near}, IDW Fit {fit(ys[t], pred):.3f}, oracle {fit(ys[t], oracle):.3f}")
         all_y.append(ys[t])
         all_p.append(pred)
@@ -52,14 +57,8 @@ def main(d):
     y = np.vstack(all_y)
     print(f"all test samples: IDW Fit {fit(y, np.vstack(all_p)):.3f}, oracle {fit(y, np.vstack(all_o)):.3f}")
     for k in sorted({min(9, len(train)), len(train)} - {4}):
-        oy = []
-        for t in test:
-            near = sorted(train, key=lambda g: np.linalg.norm(xy[g] - xy[t]))[:k]
-            for s in range(len(ys[t])):
-                a = np.stack([ys[g][s] for g in near], 1)
-                c, *_ = np.linalg.lstsq(a, ys[t][s], rcond=None)
-                oy.append(a @ c)
-        print(f"all test samples: oracle over the {k} nearest training locations {fit(y, np.array(oy)):.3f}")
+        oy = [best_blend(ys, sorted(train, key=lambda g: np.linalg.norm(xy[g] - xy[t]))[:k], t) for t in test]
+        print(f"all test samples: oracle over the {k} nearest training locations {fit(y, np.vstack(oy)):.3f}")
     neighbour_means(train, xy, ys)
 
 
