@@ -25,6 +25,11 @@ def fit(y, yhat):
     return 1.0 - np.sqrt(((y - yhat) ** 2).sum() / ((y - y.mean()) ** 2).sum())
 
 
+def nearest(train, xy, t, k):
+    """The k training locations nearest to location t in the plane."""
+    return sorted(train, key=lambda g: np.linalg.norm(xy[g] - xy[t]))[:k]
+
+
 def best_blend(ys, near, t):
     """Least-squares blend of the fields of `near` fitted to location t's field, per time stamp."""
     out = []
@@ -45,7 +50,7 @@ def main(d):
     test = sorted({labels[i] for i in loc[split == 1]})
     all_y, all_p, all_o = [], [], []
     for t in test:
-        near = sorted(train, key=lambda g: np.linalg.norm(xy[g] - xy[t]))[:4]
+        near = nearest(train, xy, t, 4)
         w = np.array([1.0 / max(np.linalg.norm(xy[g] - xy[t]), 1e-9) for g in near])
         w /= w.sum()
         pred = sum(wi * ys[g] for wi, g in zip(w, near))
@@ -57,7 +62,7 @@ def main(d):
     y = np.vstack(all_y)
     print(f"all test samples: IDW Fit {fit(y, np.vstack(all_p)):.3f}, oracle {fit(y, np.vstack(all_o)):.3f}")
     for k in sorted({min(9, len(train)), len(train)} - {4}):
-        oy = [best_blend(ys, sorted(train, key=lambda g: np.linalg.norm(xy[g] - xy[t]))[:k], t) for t in test]
+        oy = [best_blend(ys, nearest(train, xy, t, k), t) for t in test]
         print(f"all test samples: oracle over the {k} nearest training locations {fit(y, np.vstack(oy)):.3f}")
     neighbour_means(train, xy, ys)
 
