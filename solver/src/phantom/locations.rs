@@ -24,8 +24,13 @@
 //!
 //! The raster is visited row by row from the cranial row to the caudal one, each row from
 //! the patient's right (x min) to the left, like the paper's top-left-to-bottom-right order.
-//! The test locations are searched over every voxel column in the raster's box widened by
-//! 30 mm, among columns with at least 15 mm of liver:
+//! The test locations are searched over the columns of a label volume with
+//! [`TEST_SEARCH_VOXEL`] voxels, whatever the mesh's voxel size, so that every mesh of one body is
+//! pressed at the same A, B and C (a mesh-size study compares like with like). Searched over
+//! the mesh's own columns, the 3 mm phantom put C 3 mm from A (the first rib column beside it)
+//! and B 16.5 mm outside the raster; the 5 mm search puts them 17 mm apart, inside it. The
+//! search covers every column in the raster's box widened by 30 mm, among columns with at
+//! least 15 mm of liver:
 //! - A: liver near the surface, not under the ribs: below the rib cage (no rib in the anterior
 //!   half of this column or of any column caudal to it), smallest depth;
 //! - B: liver deeper: below the rib cage, largest depth up to 80 mm;
@@ -263,10 +268,17 @@ pub fn location_at(
 }
 
 /// Build the raster and find A, B and C.
+/// Voxel size (m) of the label volume the test locations are searched in.
+pub const TEST_SEARCH_VOXEL: f64 = 0.005;
+
+/// The raster and the test locations. `vol` is the mesh's label volume; `search` the one the
+/// test locations are searched in (module doc), `vol` itself when the mesh has
+/// [`TEST_SEARCH_VOXEL`] voxels.
 pub fn find_locations(
     mesh: &Mesh,
     skin: &[[u32; 4]],
     vol: &LabelVolume,
+    search: &LabelVolume,
     g: &GridParams,
 ) -> Result<Locations, String> {
     let mut grid = Vec::new();
@@ -290,16 +302,16 @@ pub fn find_locations(
     let lo = [x0 - margin, y0 - g.spacing[1] * (ny as f64 - 1.0) - margin];
     let hi = [x0 + g.spacing[0] * (nx as f64 - 1.0) + margin, y0 + margin];
     // a column is below the rib cage when no rib lies in it or in any column caudal to it
-    let mut below_cage = vec![false; vol.dims[0] * vol.dims[1]];
-    for i in 0..vol.dims[0] {
+    let mut below_cage = vec![false; search.dims[0] * search.dims[1]];
+    for i in 0..search.dims[0] {
         let mut seen = false;
-        for j in 0..vol.dims[1] {
-            seen |= (0..vol.dims[2]).any(|k| {
-                vol.get(i, j, k) == RIBS
-                    && vol.voxel_center(i, j, k)[2]
-                        > 0.5 * vol.voxel_center(i, j, vol.dims[2] - 1)[2]
+        for j in 0..search.dims[1] {
+            seen |= (0..search.dims[2]).any(|k| {
+                search.get(i, j, k) == RIBS
+                    && search.voxel_center(i, j, k)[2]
+                        > 0.5 * search.voxel_center(i, j, search.dims[2] - 1)[2]
             });
-            below_cage[i + vol.dims[0] * j] = !seen;
+            below_cage[i + search.dims[0] * j] = !seen;
         }
     }
     let (mut a, mut b, mut c): (
@@ -307,13 +319,13 @@ pub fn find_locations(
         Option<(f64, usize, usize)>,
         Option<(f64, usize, usize)>,
     ) = (None, None, None);
-    for j in 0..vol.dims[1] {
-        for i in 0..vol.dims[0] {
-            let p = vol.voxel_center(i, j, 0);
+    for j in 0..search.dims[1] {
+        for i in 0..search.dims[0] {
+            let p = search.voxel_center(i, j, 0);
             if p[0] < lo[0] || p[0] > hi[0] || p[1] < lo[1] || p[1] > hi[1] {
                 continue;
             }
-            let col = column(vol, i, j);
+            let col = column(search, i, j);
             let Some(d) = col.depth else { continue };
             if col.liver_thickness < 0.015 {
                 continue;
@@ -322,7 +334,7 @@ pub fn find_locations(
                 if c.is_none_or(|q| d < q.0) {
                     c = Some((d, i, j));
                 }
-            } else if below_cage[i + vol.dims[0] * j] {
+            } else if below_cage[i + search.dims[0] * j] {
                 if a.is_none_or(|q| d < q.0) {
                     a = Some((d, i, j));
                 }
@@ -334,7 +346,7 @@ pub fn find_locations(
     }
     let pick = |q: Option<(f64, usize, usize)>, name: &str| -> Result<Location, String> {
         let (_, i, j) = q.ok_or_else(|| format!("no column qualifies for test location {name}"))?;
-        let p = vol.voxel_center(i, j, 0);
+        let p = search.voxel_center(i, j, 0);
         make(mesh, skin, vol, name, p[0], p[1])
     };
     Ok(Locations {

@@ -54,6 +54,7 @@ mod roi;
 pub use anatomy::{Anatomy, BACKGROUND, FLESH, LIVER, RIBS, SPINE, TUMOUR, VISCERA};
 pub use locations::{
     cast_down, find_locations, location_at, skin_fit, Location, Locations, SKIN_FIT_RADIUS,
+    TEST_SEARCH_VOXEL,
 };
 pub use params::{
     GridParams, PhantomParams, RoiParams, Tumour, Variant, DEFAULT_VOXEL, PAPER_VOXEL,
@@ -264,7 +265,21 @@ pub fn build(p: &PhantomParams) -> Result<Phantom, String> {
     rs.sort_unstable();
     mesh.element_sets.insert("roi".into(), rs);
 
-    let locations = find_locations(&mesh, &skin_faces, &volume, &p.grid)?;
+    let search = if (p.voxel - TEST_SEARCH_VOXEL).abs() > 1e-12 {
+        Some(label_volume(&PhantomParams {
+            voxel: TEST_SEARCH_VOXEL,
+            ..p.clone()
+        })?)
+    } else {
+        None
+    };
+    let locations = find_locations(
+        &mesh,
+        &skin_faces,
+        &volume,
+        search.as_ref().unwrap_or(&volume),
+        &p.grid,
+    )?;
     quality = {
         let mut q = MeshQuality::measure(&mesh);
         q.cleanup = quality.cleanup;

@@ -276,3 +276,33 @@ fn location_normals_follow_the_torso_not_the_voxel_steps() {
     assert!(dn < 3.0, "neighbours 2.5 mm apart press {dn:.1} deg apart");
     assert!(d2 < 5e-4, "height second difference {:.2} mm", d2 * 1e3);
 }
+
+/// A, B and C are searched on the same 5 mm columns whatever the mesh's voxel size, so two meshes
+/// of one body are pressed at the same test locations; searched on the mesh's own columns, 7 and
+/// 8 mm meshes put them at different places (the 3 mm mesh put C 3 mm from A).
+#[test]
+fn test_locations_do_not_depend_on_the_voxel_size() {
+    let at = |voxel: f64| {
+        let ph = build(&PhantomParams {
+            voxel,
+            ..coarse(Variant::Reduced)
+        })
+        .unwrap();
+        let l = ph.locations;
+        [l.a, l.b, l.c].map(|x| [x.surface[0], x.surface[1]])
+    };
+    let (p8, p7) = (at(0.008), at(0.007));
+    for (q, name) in ["A", "B", "C"].iter().enumerate() {
+        for k in 0..2 {
+            assert!(
+                (p8[q][k] - p7[q][k]).abs() < 1e-12,
+                "{name}: {:?} at 8 mm, {:?} at 7 mm",
+                p8[q],
+                p7[q]
+            );
+            // on the centre of a 5 mm column
+            let r = (p8[q][k] / TEST_SEARCH_VOXEL - 0.5).rem_euclid(1.0);
+            assert!(r.min(1.0 - r) < 1e-9, "{name} at {:?}", p8[q]);
+        }
+    }
+}
