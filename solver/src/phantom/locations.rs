@@ -267,7 +267,6 @@ pub fn location_at(
     make(mesh, skin, vol, name, x, y)
 }
 
-/// Build the raster and find A, B and C.
 /// Voxel size (m) of the label volume the test locations are searched in.
 pub const TEST_SEARCH_VOXEL: f64 = 0.005;
 
