@@ -115,6 +115,53 @@ fn read_json(path: &Path) -> Result<Value, String> {
     serde_json::from_str(&s).map_err(|e| format!("{}: {e}", path.display()))
 }
 
+/// Where two campaign plans first differ, for the message that refuses to mix them:
+/// `plan.locations[26].surface_m[0]: -0.0705 there, -0.0725 here`. `None` when equal.
+fn first_difference(there: &Value, here: &Value, path: &str) -> Option<String> {
+    let short = |v: &Value| {
+        let s = v.to_string();
+        if s.chars().count() > 60 {
+            format!("{}...", s.chars().take(57).collect::<String>())
+        } else {
+            s
+        }
+    };
+    match (there, here) {
+        (Value::Object(a), Value::Object(b)) => {
+            let mut keys: Vec<&String> = a.keys().chain(b.keys()).collect();
+            keys.sort();
+            keys.dedup();
+            keys.into_iter().find_map(|k| {
+                let (x, y) = (a.get(k), b.get(k));
+                match (x, y) {
+                    (Some(x), Some(y)) => first_difference(x, y, &format!("{path}.{k}")),
+                    _ => Some(format!(
+                        "{path}.{k}: {} there, {} here",
+                        x.map_or("absent".into(), short),
+                        y.map_or("absent".into(), short)
+                    )),
+                }
+            })
+        }
+        (Value::Array(a), Value::Array(b)) if a.len() == b.len() => a
+            .iter()
+            .zip(b)
+            .enumerate()
+            .find_map(|(i, (x, y))| first_difference(x, y, &format!("{path}[{i}]"))),
+        (Value::Array(a), Value::Array(b)) => Some(format!(
+            "{path}: {} entries there, {} here",
+            a.len(),
+            b.len()
+        )),
+        _ if there != here => Some(format!(
+            "{path}: {} there, {} here",
+            short(there),
+            short(here)
+        )),
+        _ => None,
+    }
+}
+
 fn write_json(path: &Path, v: &Value) -> Result<(), String> {
     let s = serde_json::to_string_pretty(v).map_err(|e| e.to_string())?;
     write_atomic(path, s.as_bytes())
@@ -209,10 +256,11 @@ fn run_campaign(a: &CampaignArgs) -> Result<(), String> {
     let desc = campaign_file(&plan, shard);
     if cfile.exists() {
         let old = read_json(&cfile)?;
-        if old.get("plan") != Some(&plan) {
+        if let Some(d) = first_difference(old.get("plan").unwrap_or(&Value::Null), &plan, "plan") {
             return Err(format!(
-                "{} holds a different campaign (other settings, phantom, locations or runs); choose a new --out",
-                out.display()
+                "{} holds a different campaign ({d}; there = {}, here = this campaign file and palpa); choose a new --out",
+                out.display(),
+                cfile.display()
             ));
         }
         if old.get("solver_version") != desc.get("solver_version") && !a.quiet {
@@ -716,10 +764,13 @@ fn merge(dirs: &[PathBuf], out: &Path, quiet: bool) -> Result<(), String> {
         match &plan {
             None => plan = Some(v["plan"].clone()),
             Some(p) if *p != v["plan"] => {
+                let diff = first_difference(p, &v["plan"], "plan").unwrap_or_default();
                 return Err(format!(
-                    "{} is a different campaign from {} (settings, phantom, locations or runs differ)",
+                    "{} is a different campaign from {} ({diff}; there = {}, here = {})",
                     d.display(),
-                    dirs[0].display()
+                    dirs[0].display(),
+                    dirs[0].display(),
+                    d.display()
                 ));
             }
             _ => {}
@@ -779,4 +830,40 @@ fn merge(dirs: &[PathBuf], out: &Path, quiet: bool) -> Result<(), String> {
         print_dataset(&ds, out, false);
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::first_difference;
+    use serde_json::json;
+
+    #[test]
+    fn first_difference_names_the_path_and_both_values() {
+        let there =
+            json!({"runs": [1, 2], "locations": [{"label": "A", "surface_m": [-0.0705, 0.1785]}]});
+        let mut here = there.clone();
+        assert_eq!(first_difference(&there, &here, "plan"), None);
+        here["locations"][0]["surface_m"][0] = json!(-0.0725);
+        assert_eq!(
+            first_difference(&there, &here, "plan").as_deref(),
+            Some("plan.locations[0].surface_m[0]: -0.0705 there, -0.0725 here")
+        );
+        here["runs"] = json!([1, 2, 3]);
+        here["title"] = json!("new");
+        // keys in sorted order: locations, runs, title
+        assert_eq!(
+            first_difference(&there, &here, "plan").as_deref(),
+            Some("plan.locations[0].surface_m[0]: -0.0705 there, -0.0725 here")
+        );
+        here["locations"] = there["locations"].clone();
+        assert_eq!(
+            first_difference(&there, &here, "plan").as_deref(),
+            Some("plan.runs: 2 entries there, 3 here")
+        );
+        here["runs"] = json!([1, 2]);
+        assert_eq!(
+            first_difference(&there, &here, "plan").as_deref(),
+            Some("plan.title: absent there, \"new\" here")
+        );
+    }
 }
