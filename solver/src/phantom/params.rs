@@ -141,7 +141,7 @@ impl PhantomParams {
 
     /// Check ranges.
     pub fn validate(&self) -> Result<(), String> {
-        if !(self.voxel > 0.0005 && self.voxel < 0.05) {
+        if !(0.0005..=0.05).contains(&self.voxel) {
             return Err(format!(
                 "`voxel` = {} m is out of range (0.5 mm .. 50 mm)",
                 self.voxel
@@ -171,5 +171,33 @@ impl PhantomParams {
             return Err("too many tumours".into());
         }
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The stated range is inclusive at both ends, and the message names the field and the range.
+    #[test]
+    fn test_voxel_range_is_inclusive_as_stated() {
+        for ok in [0.0005, 0.005, 0.05] {
+            let p = PhantomParams {
+                voxel: ok,
+                ..Default::default()
+            };
+            assert!(p.validate().is_ok(), "voxel {ok} m should be accepted");
+        }
+        for bad in [0.0004, 0.051, 0.0, -0.005, f64::NAN] {
+            let p = PhantomParams {
+                voxel: bad,
+                ..Default::default()
+            };
+            let e = p.validate().unwrap_err();
+            assert!(
+                e.contains("`voxel`") && e.contains("0.5 mm .. 50 mm"),
+                "{e}"
+            );
+        }
     }
 }
