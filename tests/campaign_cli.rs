@@ -9,8 +9,9 @@
 //!   redoes an unfinished run directory from scratch; without `--resume` it refuses to touch
 //!   the finished runs;
 //! - the shipped profiles (scenes/campaign-quick.toml, scenes/campaign-paper.toml,
-//!   scenes/campaign-fbar-8mm.toml) resolve on their phantoms (`--dry-run`), and a bad key is
-//!   an error naming it.
+//!   scenes/campaign-fbar-8mm.toml, scenes/campaign-wide-grid.toml) resolve on their phantoms
+//!   (`--dry-run`), the default raster covers the ROI's plan extent, and a bad key is an error
+//!   naming it.
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
@@ -278,25 +279,45 @@ fn shipped_profiles_resolve_and_bad_keys_are_named() {
         fbar.contains("28 runs (28 locations: 25 train, 3 test)") && fbar.contains("voxel 8.0 mm"),
         "{fbar}"
     );
-    // the ROI-fitted raster: rows 15 mm apart from y = 225 to 165 mm, with the default A, B, C
-    let roi = dry_run("campaign-roi-raster.toml");
+    // the y of each raster row in a plan table, from the rows whose label starts with `prefix`
+    let ys = |table: &str, prefix: char| -> Vec<f64> {
+        table
+            .lines()
+            .filter(|l| l.trim_start().starts_with(prefix))
+            .filter_map(|l| l.split_whitespace().nth(4)?.parse().ok())
+            .collect()
+    };
+    // the default raster (P01..P25) covers the ROI's plan extent: rows 15 mm apart, y = 225..165 mm
+    let p = ys(&paper, 'P');
+    assert_eq!(p.len(), 25, "{paper}");
     assert!(
-        roi.contains("28 runs (28 locations: 25 train, 3 test)"),
-        "{roi}"
+        (p[0] - 225.0).abs() < 1e-9 && (p[24] - 165.0).abs() < 1e-9,
+        "{p:?}"
     );
-    for row in ["R01 ", "R25 "] {
-        assert!(roi.contains(row), "{roi}");
-    }
-    let ys: Vec<f64> = roi
-        .lines()
-        .filter(|l| l.trim_start().starts_with('R'))
-        .filter_map(|l| l.split_whitespace().nth(4)?.parse().ok())
-        .collect();
-    assert_eq!(ys.len(), 25, "{roi}");
+    // the earlier raster: rows 25 mm apart, y = 245..145 mm, with the default A, B, C
+    let wide = dry_run("campaign-wide-grid.toml");
     assert!(
-        (ys[0] - 225.0).abs() < 1e-9 && (ys[24] - 165.0).abs() < 1e-9,
-        "{ys:?}"
+        wide.contains("28 runs (28 locations: 25 train, 3 test)"),
+        "{wide}"
     );
+    let w = ys(&wide, 'W');
+    assert_eq!(w.len(), 25, "{wide}");
+    assert!(
+        (w[0] - 245.0).abs() < 1e-9 && (w[24] - 145.0).abs() < 1e-9,
+        "{w:?}"
+    );
+    let abc = |t: &str| -> Vec<String> {
+        t.lines()
+            .filter(|l| {
+                ["A ", "B ", "C "]
+                    .iter()
+                    .any(|k| l.trim_start().starts_with(k))
+            })
+            .map(|l| l.split_whitespace().take(5).collect::<Vec<_>>().join(" "))
+            .collect()
+    };
+    assert_eq!(abc(&paper).len(), 3, "{paper}");
+    assert_eq!(abc(&paper), abc(&wide));
 
     let tmp = tempfile::tempdir().unwrap();
     let bad = tmp.path().join("bad.toml");

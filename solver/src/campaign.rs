@@ -384,23 +384,21 @@ fn raster_locations(r: &RasterSpec) -> Result<(Split, Vec<CampaignLocation>), St
     if nx == 0 || ny == 0 {
         return Err("locations.raster: n must be at least [1, 1]".into());
     }
-    let (c, s) = (
-        [r.center[0].0, r.center[1].0],
-        [r.spacing[0].0, r.spacing[1].0],
-    );
-    let mut out = Vec::new();
-    // cranial row first (largest y), each row from the patient's right (smallest x)
-    for j in (0..ny).rev() {
-        for i in 0..nx {
-            let x = c[0] + (i as f64 - (nx as f64 - 1.0) / 2.0) * s[0];
-            let y = c[1] + (j as f64 - (ny as f64 - 1.0) / 2.0) * s[1];
-            out.push(CampaignLocation {
-                label: format!("{prefix}{:02}", out.len() + 1),
-                split,
-                place: Place::At(x, y),
-            });
-        }
-    }
+    let grid = crate::phantom::GridParams {
+        center: [r.center[0].0, r.center[1].0],
+        spacing: [r.spacing[0].0, r.spacing[1].0],
+        n: r.n,
+    };
+    let out = grid
+        .points()
+        .into_iter()
+        .enumerate()
+        .map(|(k, [x, y])| CampaignLocation {
+            label: format!("{prefix}{:02}", k + 1),
+            split,
+            place: Place::At(x, y),
+        })
+        .collect();
     Ok((split, out))
 }
 
@@ -408,7 +406,7 @@ fn raster_locations(r: &RasterSpec) -> Result<(Split, Vec<CampaignLocation>), St
 /// 15 mm ([`PalpationSetup`]'s default).
 ///
 /// The paper's protocol presses 15 mm at every raster point, including the cranial and lateral
-/// points over the ribs (P11, P12, P16). Over 15 mm of flesh, a 15 mm indentation there crushes
+/// points over the ribs (P11, P12 and, on the earlier raster with rows 25 mm apart, P16). Over 15 mm of flesh, a 15 mm indentation there crushes
 /// the flesh between finger and rib to nothing. At 5 mm voxels, P12 then stopped at its
 /// mass-scaling limit: 14.1 % of the flesh's mass had been added over 98 elements, and one
 /// element needed a 619x density scale. With 25 mm, every run of the protocol finishes with at

@@ -280,26 +280,21 @@ pub fn find_locations(
     search: &LabelVolume,
     g: &GridParams,
 ) -> Result<Locations, String> {
-    let mut grid = Vec::new();
-    let (nx, ny) = (g.n[0], g.n[1]);
-    let x0 = g.center[0] - g.spacing[0] * (nx as f64 - 1.0) / 2.0;
-    let y0 = g.center[1] + g.spacing[1] * (ny as f64 - 1.0) / 2.0;
-    for r in 0..ny {
-        for c in 0..nx {
-            let name = format!("P{:02}", r * nx + c + 1);
-            grid.push(make(
-                mesh,
-                skin,
-                vol,
-                &name,
-                x0 + c as f64 * g.spacing[0],
-                y0 - r as f64 * g.spacing[1],
-            )?);
+    let points = g.points();
+    let grid = points
+        .iter()
+        .enumerate()
+        .map(|(k, p)| make(mesh, skin, vol, &format!("P{:02}", k + 1), p[0], p[1]))
+        .collect::<Result<Vec<_>, _>>()?;
+    // the search box: the raster's bounding box widened by `margin`
+    let margin = 0.03;
+    let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+    for p in &points {
+        for a in 0..2 {
+            lo[a] = lo[a].min(p[a] - margin);
+            hi[a] = hi[a].max(p[a] + margin);
         }
     }
-    let margin = 0.03;
-    let lo = [x0 - margin, y0 - g.spacing[1] * (ny as f64 - 1.0) - margin];
-    let hi = [x0 + g.spacing[0] * (nx as f64 - 1.0) + margin, y0 + margin];
     // a column is below the rib cage when no rib lies in it or in any column caudal to it
     let mut below_cage = vec![false; search.dims[0] * search.dims[1]];
     for i in 0..search.dims[0] {
