@@ -130,7 +130,7 @@ pub struct PhantomArgs {
     /// Palpation raster centre x,y [default: -50mm,195mm].
     #[arg(long, value_name = "X,Y", value_parser = point2, allow_hyphen_values = true)]
     grid_center: Option<[f64; 2]>,
-    /// Palpation raster spacing along x,y [default: 25mm,25mm].
+    /// Palpation raster spacing along x,y [default: 25mm,15mm].
     #[arg(long, value_name = "DX,DY", value_parser = point2)]
     grid_spacing: Option<[f64; 2]>,
     /// Palpation raster points along x,y [default: 5,5].
