@@ -69,8 +69,9 @@ def probe_gp(d):
     first = np.sort(first)
     for name, k in kernels().items():
         g = Gpr(k, n_restarts_optimizer=2, random_state=0).fit(u[first], v[first])
+        lml = g.log_marginal_likelihood_value_
         g = Gpr(g.kernel_, optimizer=None).fit(u, v)
-        d.report(f"GP {name}, marginal likelihood ({g.kernel_})", g.predict(d.u[d.te]) * d.s + d.ym)
+        d.report(f"GP {name}, marginal likelihood (log {lml:.1f}; {g.kernel_})", g.predict(d.u[d.te]) * d.s + d.ym)
 
 
 def probe_gp_lolo(d):
