@@ -9,9 +9,9 @@
 //!   redoes an unfinished run directory from scratch; without `--resume` it refuses to touch
 //!   the finished runs;
 //! - the shipped profiles (scenes/campaign-quick.toml, scenes/campaign-paper.toml,
-//!   scenes/campaign-fbar-8mm.toml, scenes/campaign-wide-grid.toml) resolve on their phantoms
-//!   (`--dry-run`), the default raster covers the ROI's plan extent, and a bad key is an error
-//!   naming it.
+//!   scenes/campaign-5mm.toml, scenes/campaign-fbar-8mm.toml, scenes/campaign-wide-grid.toml)
+//!   resolve on their phantoms (`--dry-run`), the default raster covers the ROI's plan extent,
+//!   and a bad key is an error naming it.
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
@@ -273,7 +273,19 @@ fn shipped_profiles_resolve_and_bad_keys_are_named() {
         paper.contains("28 runs (28 locations: 25 train, 3 test)"),
         "{paper}"
     );
-    assert!(paper.contains("voxel 5.0 mm"), "{paper}");
+    assert!(paper.contains("voxel 3.0 mm"), "{paper}");
+    // the same campaign on 5 mm voxels: the same runs at the same places (label, location,
+    // split, x, y); what lies under them (the liver depth column) is read from each mesh
+    let five = dry_run("campaign-5mm.toml");
+    assert!(five.contains("voxel 5.0 mm"), "{five}");
+    let places = |t: &str| -> Vec<String> {
+        t.lines()
+            .skip(2)
+            .map(|l| l.split_whitespace().take(5).collect::<Vec<_>>().join(" "))
+            .collect()
+    };
+    assert_eq!(places(&five).len(), 28, "{five}");
+    assert_eq!(places(&five), places(&paper));
     let fbar = dry_run("campaign-fbar-8mm.toml");
     assert!(
         fbar.contains("28 runs (28 locations: 25 train, 3 test)") && fbar.contains("voxel 8.0 mm"),

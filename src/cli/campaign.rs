@@ -47,7 +47,8 @@ pub struct CampaignArgs {
     command: Option<CampaignCommand>,
     /// The campaign file (TOML, see scenes/campaign-paper.toml); without it the paper's
     /// protocol: P01..P25 (train) and A, B, C (test), 15 mm in 25 ms, samples every 5 ms, on
-    /// the reduced phantom with 5 mm voxels.
+    /// the reduced phantom with the paper's 3 mm voxels (about 4 h on 2 cores;
+    /// scenes/campaign-5mm.toml takes about 36 min).
     file: Option<PathBuf>,
     /// Campaign directory: runs/<label>/, campaign.json, dataset.npz + manifest.json.
     #[arg(long, default_value = "results/campaign")]
