@@ -417,8 +417,9 @@ pub const CAMPAIGN_VOXEL: f64 = PAPER_VOXEL;
 /// 15 mm ([`PalpationSetup`]'s default).
 ///
 /// The paper's protocol presses 15 mm at every raster point, including the cranial and lateral
-/// points over the ribs (P11, P12 and, on the earlier raster with rows 25 mm apart, P16). Over 15 mm of flesh, a 15 mm indentation there crushes
-/// the flesh between finger and rib to nothing. At 5 mm voxels, P12 then stopped at its
+/// points over the ribs (P11, P12 and, on the earlier raster with rows 25 mm apart, P16). Over
+/// 15 mm of flesh, a 15 mm indentation there crushes the flesh between finger and rib to
+/// nothing. At 5 mm voxels, P12 then stopped at its
 /// mass-scaling limit: 14.1 % of the flesh's mass had been added over 98 elements, and one
 /// element needed a 619x density scale. With 25 mm, every run of the protocol finishes with at
 /// most 2.2 % of the flesh's mass added. 25 mm is within the range of adult abdominal
