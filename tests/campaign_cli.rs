@@ -318,14 +318,11 @@ fn shipped_profiles_resolve_and_bad_keys_are_named() {
         (w[0] - 245.0).abs() < 1e-9 && (w[24] - 145.0).abs() < 1e-9,
         "{w:?}"
     );
+    // the test locations' rows of a plan table (label, location, split, x, y)
     let abc = |t: &str| -> Vec<String> {
-        t.lines()
-            .filter(|l| {
-                ["A ", "B ", "C "]
-                    .iter()
-                    .any(|k| l.trim_start().starts_with(k))
-            })
-            .map(|l| l.split_whitespace().take(5).collect::<Vec<_>>().join(" "))
+        places(t)
+            .into_iter()
+            .filter(|l| ["A ", "B ", "C "].iter().any(|k| l.starts_with(k)))
             .collect()
     };
     assert_eq!(abc(&paper).len(), 3, "{paper}");
