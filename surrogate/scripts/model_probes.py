@@ -13,11 +13,18 @@ above what `palpa train` gives on the same data.
 - pointwise: one MLP (scikit-learn, 3 hidden layers) over every (sample, ROI element) pair, with
   inputs finger x, y, force, the element's centroid and its plan offset from the fingers, so
   that it can learn a stress pattern that moves with the hand.
+- cv: model choice without the test locations. Each interior raster location (one with
+  training neighbours on every side, as A, B and C have) is left out in turn and predicted
+  from the rest, by the GP as `palpa train` and by the same GP over the stress per newton of
+  contact force, Y / F (a kernel F F' k(x, x'), so that the stress vanishes with the force, as
+  it does in the solver), with the SE, Matern 5/2 and a two-scale SE + SE kernel (a narrow
+  one for the hot spot under the fingers, a wide one for the background). Only training locations are used, so this probe can pick a model
+  before anyone looks at A, B and C, and it runs on a campaign that is still going.
 - shift: inverse-distance weighting of the 4 nearest training fields, each first shifted in plan
   by a fraction alpha of the offset between its hand and the test hand (alpha 0 = plain IDW),
   the shifted field read off with a 4 mm Gaussian kernel over the ROI centroids.
 
-    python surrogate/scripts/model_probes.py CAMPAIGN_DIR [gp] [gp-lolo] [pointwise] [shift]
+    python surrogate/scripts/model_probes.py CAMPAIGN_DIR [gp] [gp-lolo] [pointwise] [shift] [cv]
     (needs numpy, scipy and scikit-learn; the pointwise probe takes a few minutes)
 """
 import sys
@@ -58,6 +65,8 @@ def kernels():
         "Matern 5/2": ConstantKernel(1.0) * Matern([1.0] * 3, (1e-2, 1e2), nu=2.5) + noise,
         "Matern 3/2": ConstantKernel(1.0) * Matern([1.0] * 3, (1e-2, 1e2), nu=1.5) + noise,
         "Matern 1/2": ConstantKernel(1.0) * Matern([1.0] * 3, (1e-2, 1e2), nu=0.5) + noise,
+        "SE + SE": ConstantKernel(1.0) * RBF([0.5] * 3, (1e-2, 1e2))
+        + ConstantKernel(1.0) * RBF([2.0] * 3, (1e-2, 1e2)) + noise,
     }
 
 
@@ -112,6 +121,60 @@ def probe_gp_lolo(d):
         ls = ", ".join(f"{x:.2f}" for x in np.exp(th[:3]))
         d.report(f"GP {name}, leave-one-location-out hyperparameters (lengths {ls}, noise {np.exp(th[3]):.4f})",
                  predict(u, v, d.u[d.te], th, nu) * d.s + d.ym)
+
+
+def gp_fit_predict(k, u, y, ut, per_newton, f=None, ft=None):
+    """The GP as `palpa train` (outputs centred per element, one pooled scale, hyperparameters by
+    marginal likelihood over the rows with distinct targets), predicting at `ut`. With
+    `per_newton` it models Y / F over the rows with F > 0 and predicts F* times that."""
+    from sklearn.gaussian_process import GaussianProcessRegressor as Gpr
+
+    if per_newton:
+        m = f > 0
+        u, y = u[m], y[m] / f[m, None]
+    ym, s = y.mean(0), np.sqrt(y.var(0).mean())
+    v = (y - ym) / s
+    _, first = np.unique(np.round(v, 12), axis=0, return_index=True)
+    g = Gpr(k, n_restarts_optimizer=2, random_state=0).fit(u[np.sort(first)], v[np.sort(first)])
+    pred = Gpr(g.kernel_, optimizer=None).fit(u, v).predict(ut) * s + ym
+    return pred * ft[:, None] if per_newton else pred
+
+
+def probe_cv(d):
+    locs = list(np.unique(d.loc[d.tr]))
+    xy = {l: d.x[d.loc == l][0, :2] for l in locs}
+    step = np.array([np.diff(np.unique(np.round(d.x[d.tr, i], 6))).min() for i in (0, 1)])
+
+    def has(l, o):
+        return any(np.allclose(xy[g], xy[l] + np.array(o) * step, atol=1e-6) for g in locs)
+
+    sets = {
+        "interior (neighbours on 4 sides)": [l for l in locs if all(has(l, o) for o in ((1, 0), (-1, 0), (0, 1), (0, -1)))],
+        "between two neighbours (along x or y)": [l for l in locs if (has(l, (1, 0)) and has(l, (-1, 0))) or (has(l, (0, 1)) and has(l, (0, -1)))],
+    }
+    ks = kernels()
+    for what, inner in sets.items():
+        print(f"cv, {len(locs)} training locations, {what}, each left out in turn: {' '.join(map(str, inner))}")
+        if not inner:
+            continue
+        for name in ("SE", "Matern 5/2", "SE + SE"):
+            for per_newton in (False, True):
+                truth, pred, per = [], [], []
+                for l in inner:
+                    tr = d.tr & (d.loc != l)
+                    te = d.loc == l
+                    p = gp_fit_predict(ks[name], d.u[tr], d.y[tr], d.u[te], per_newton, d.x[tr, 2], d.x[te, 2])
+                    truth.append(d.y[te])
+                    pred.append(p)
+                    per.append(fit(d.y[te], p))
+                tag = "Y / F" if per_newton else "Y"
+                print(f"  GP {name} on {tag}: Fit {fit(np.vstack(truth), np.vstack(pred)):.3f} "
+                      f"(mean {np.mean(per):.3f}, worst {min(per):.3f})", flush=True)
+    if d.te.any():
+        for name in ("SE", "Matern 5/2", "SE + SE"):
+            for per_newton in (False, True):
+                p = gp_fit_predict(ks[name], d.u[d.tr], d.y[d.tr], d.u[d.te], per_newton, d.x[d.tr, 2], d.x[d.te, 2])
+                d.report(f"GP {name} on {'Y / F' if per_newton else 'Y'}, test locations", p)
 
 
 def probe_pointwise(d):
@@ -171,7 +234,7 @@ def probe_shift(d):
 def main(argv):
     d = Data(argv[0])
     probes = argv[1:] or ["gp", "gp-lolo", "shift"]
-    table = {"gp": probe_gp, "gp-lolo": probe_gp_lolo, "pointwise": probe_pointwise, "shift": probe_shift}
+    table = {"gp": probe_gp, "gp-lolo": probe_gp_lolo, "pointwise": probe_pointwise, "shift": probe_shift, "cv": probe_cv}
     for p in probes:
         table[p](d)
 
