@@ -13,13 +13,14 @@ above what `palpa train` gives on the same data.
 - pointwise: one MLP (scikit-learn, 3 hidden layers) over every (sample, ROI element) pair, with
   inputs finger x, y, force, the element's centroid and its plan offset from the fingers, so
   that it can learn a stress pattern that moves with the hand.
-- cv: model choice without the test locations. Each interior raster location (one with
-  training neighbours on every side, as A, B and C have) is left out in turn and predicted
-  from the rest, by the GP as `palpa train` and by the same GP over the stress per newton of
-  contact force, Y / F (a kernel F F' k(x, x'), so that the stress vanishes with the force, as
-  it does in the solver), with the SE, Matern 5/2 and a two-scale SE + SE kernel (a narrow
-  one for the hot spot under the fingers, a wide one for the background). Only training locations are used, so this probe can pick a model
-  before anyone looks at A, B and C, and it runs on a campaign that is still going.
+- cv: model choice without the test locations. Each training location between raster
+  neighbours (on all 4 sides, and, as a second set, on both sides along x or y) is left out in
+  turn and predicted from the rest. Models: the GP as `palpa train` with the SE, Matern 5/2 and
+  a two-scale SE + SE kernel (a narrow one for the hot spot under the fingers, a wide one for
+  the background), each also over the stress per newton of contact force, Y / F (a kernel
+  F F' k(x, x'), so that the stress vanishes with the force, as it does in the solver). Only
+  training locations are used, so it can pick a model before anyone looks at A, B and C, and
+  it runs on a campaign that is still going.
 - shift: inverse-distance weighting of the 4 nearest training fields, each first shifted in plan
   by a fraction alpha of the offset between its hand and the test hand (alpha 0 = plain IDW),
   the shifted field read off with a 4 mm Gaussian kernel over the ROI centroids.
@@ -27,6 +28,7 @@ above what `palpa train` gives on the same data.
     python surrogate/scripts/model_probes.py CAMPAIGN_DIR [gp] [gp-lolo] [pointwise] [shift] [cv]
     (needs numpy, scipy and scikit-learn; the pointwise probe takes a few minutes)
 """
+import json
 import sys
 import warnings
 
@@ -40,6 +42,8 @@ warnings.filterwarnings("ignore")
 class Data:
     def __init__(self, d):
         z = np.load(f"{d}/dataset.npz")
+        with open(f"{d}/manifest.json") as f:
+            self.labels = json.load(f)["location_labels"]
         self.x, self.y = z["X"][:, :3], z["Y"]
         self.loc, self.split, self.c = z["location"], z["split"], z["roi_centroids"]
         self.tr, self.te = self.split == 0, self.split != 0
@@ -52,7 +56,7 @@ class Data:
     def report(self, name, pred):
         t = self.y[self.te]
         lt = self.loc[self.te]
-        per = " / ".join(f"{fit(t[lt == l], pred[lt == l]):.3f}" for l in np.unique(lt))
+        per = " / ".join(f"{self.labels[l]} {fit(t[lt == l], pred[lt == l]):.3f}" for l in np.unique(lt))
         print(f"{name}: held-out Fit {fit(t, pred):.3f} (per location {per})", flush=True)
 
 
@@ -71,16 +75,10 @@ def kernels():
 
 
 def probe_gp(d):
-    from sklearn.gaussian_process import GaussianProcessRegressor as Gpr
-
-    u, v = d.u[d.tr], d.v[d.tr]
-    _, first = np.unique(np.round(v, 12), axis=0, return_index=True)
-    first = np.sort(first)
     for name, k in kernels().items():
-        g = Gpr(k, n_restarts_optimizer=2, random_state=0).fit(u[first], v[first])
+        pred, g = gp_fit_predict(k, d.u[d.tr], d.y[d.tr], d.u[d.te])
         lml = g.log_marginal_likelihood_value_
-        g = Gpr(g.kernel_, optimizer=None).fit(u, v)
-        d.report(f"GP {name}, marginal likelihood (log {lml:.1f}; {g.kernel_})", g.predict(d.u[d.te]) * d.s + d.ym)
+        d.report(f"GP {name}, marginal likelihood (log {lml:.1f}; {g.kernel_})", pred)
 
 
 def probe_gp_lolo(d):
@@ -123,21 +121,24 @@ def probe_gp_lolo(d):
                  predict(u, v, d.u[d.te], th, nu) * d.s + d.ym)
 
 
-def gp_fit_predict(k, u, y, ut, per_newton, f=None, ft=None):
+def gp_fit_predict(k, u, y, ut, f=None, ft=None):
     """The GP as `palpa train` (outputs centred per element, one pooled scale, hyperparameters by
-    marginal likelihood over the rows with distinct targets), predicting at `ut`. With
-    `per_newton` it models Y / F over the rows with F > 0 and predicts F* times that."""
+    marginal likelihood over the rows with distinct targets, then conditioned on every row),
+    predicting at `ut`; returns the prediction and the fitted regressor (for its likelihood).
+    Given the forces `f` (training) and `ft` (prediction) it models Y / F over the rows with
+    F > 0 and predicts F* times that."""
     from sklearn.gaussian_process import GaussianProcessRegressor as Gpr
 
-    if per_newton:
+    if f is not None:
         m = f > 0
         u, y = u[m], y[m] / f[m, None]
     ym, s = y.mean(0), np.sqrt(y.var(0).mean())
     v = (y - ym) / s
     _, first = np.unique(np.round(v, 12), axis=0, return_index=True)
-    g = Gpr(k, n_restarts_optimizer=2, random_state=0).fit(u[np.sort(first)], v[np.sort(first)])
+    first = np.sort(first)
+    g = Gpr(k, n_restarts_optimizer=2, random_state=0).fit(u[first], v[first])
     pred = Gpr(g.kernel_, optimizer=None).fit(u, v).predict(ut) * s + ym
-    return pred * ft[:, None] if per_newton else pred
+    return (pred if f is None else pred * ft[:, None]), g
 
 
 def probe_cv(d):
@@ -148,33 +149,31 @@ def probe_cv(d):
     def has(l, o):
         return any(np.allclose(xy[g], xy[l] + np.array(o) * step, atol=1e-6) for g in locs)
 
+    def between(l, axes):
+        return [has(l, o) and has(l, (-o[0], -o[1])) for o in axes]
+
     sets = {
-        "interior (neighbours on 4 sides)": [l for l in locs if all(has(l, o) for o in ((1, 0), (-1, 0), (0, 1), (0, -1)))],
-        "between two neighbours (along x or y)": [l for l in locs if (has(l, (1, 0)) and has(l, (-1, 0))) or (has(l, (0, 1)) and has(l, (0, -1)))],
+        "interior (neighbours on 4 sides)": [l for l in locs if all(between(l, ((1, 0), (0, 1))))],
+        "between two neighbours (along x or y)": [l for l in locs if any(between(l, ((1, 0), (0, 1))))],
     }
     ks = kernels()
+    variants = [(name, per_newton) for name in ("SE", "Matern 5/2", "SE + SE") for per_newton in (False, True)]
+
+    def predict(name, per_newton, tr, te):
+        forces = (d.x[tr, 2], d.x[te, 2]) if per_newton else (None, None)
+        return gp_fit_predict(ks[name], d.u[tr], d.y[tr], d.u[te], *forces)[0]
+
     for what, inner in sets.items():
-        print(f"cv, {len(locs)} training locations, {what}, each left out in turn: {' '.join(map(str, inner))}")
-        if not inner:
-            continue
-        for name in ("SE", "Matern 5/2", "SE + SE"):
-            for per_newton in (False, True):
-                truth, pred, per = [], [], []
-                for l in inner:
-                    tr = d.tr & (d.loc != l)
-                    te = d.loc == l
-                    p = gp_fit_predict(ks[name], d.u[tr], d.y[tr], d.u[te], per_newton, d.x[tr, 2], d.x[te, 2])
-                    truth.append(d.y[te])
-                    pred.append(p)
-                    per.append(fit(d.y[te], p))
-                tag = "Y / F" if per_newton else "Y"
-                print(f"  GP {name} on {tag}: Fit {fit(np.vstack(truth), np.vstack(pred)):.3f} "
-                      f"(mean {np.mean(per):.3f}, worst {min(per):.3f})", flush=True)
-    if d.te.any():
-        for name in ("SE", "Matern 5/2", "SE + SE"):
-            for per_newton in (False, True):
-                p = gp_fit_predict(ks[name], d.u[d.tr], d.y[d.tr], d.u[d.te], per_newton, d.x[d.tr, 2], d.x[d.te, 2])
-                d.report(f"GP {name} on {'Y / F' if per_newton else 'Y'}, test locations", p)
+        print(f"cv, {len(locs)} training locations, {what}, each left out in turn: "
+              f"{' '.join(d.labels[l] for l in inner)}")
+        for name, per_newton in variants if inner else []:
+            truth = [d.y[d.loc == l] for l in inner]
+            pred = [predict(name, per_newton, d.tr & (d.loc != l), d.loc == l) for l in inner]
+            per = [fit(t, p) for t, p in zip(truth, pred)]
+            print(f"  GP {name} on {'Y / F' if per_newton else 'Y'}: Fit {fit(np.vstack(truth), np.vstack(pred)):.3f} "
+                  f"(mean {np.mean(per):.3f}, worst {min(per):.3f})", flush=True)
+    for name, per_newton in variants if d.te.any() else []:
+        d.report(f"GP {name} on {'Y / F' if per_newton else 'Y'}, test locations", predict(name, per_newton, d.tr, d.te))
 
 
 def probe_pointwise(d):
