@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Creates (or checks) the two Python environments of the reference scripts:
-#   .venv-skfem    Python 3.11 + requirements-skfem.txt   (scikit-fem, numpy, scipy)
+#   .venv-skfem    Python 3.11 + requirements-skfem.txt   (scikit-fem, numpy, scipy, scikit-learn)
 #   .venv-fenicsx  Python 3.12 + requirements-fenicsx.txt (dolfinx-solver-real, mpi4py, numpy)
 # at the repository root (both ignored by git: /.venv*).
 #
@@ -70,7 +70,7 @@ make_env() {
 }
 
 make_env .venv-skfem "$PY311" "$HERE/requirements-skfem.txt" \
-    "import numpy, scipy, skfem" &
+    "import numpy, scipy, skfem, sklearn" &
 pid_sk=$!
 make_env .venv-fenicsx "$PY312" "$HERE/requirements-fenicsx.txt" \
     "from mpi4py import MPI; import dolfinx, dolfinx.fem.petsc, basix, ffcx, ufl" &
