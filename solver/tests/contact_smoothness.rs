@@ -4,7 +4,6 @@
 //! reaction along the pressing direction, every step).
 
 mod common;
-use solver::simulation::ForceStage;
 
 fn scene(motion: &str, center: &str) -> String {
     format!(
