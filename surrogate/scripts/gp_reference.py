@@ -19,6 +19,7 @@ Needs numpy, scipy and scikit-learn (the `.venv-skfem` environment of CI has the
 """
 import argparse
 import json
+import os
 import sys
 
 import numpy as np
@@ -59,13 +60,26 @@ def main(argv):
     mode.add_argument("--out", help="write the reference to this JSON file")
     mode.add_argument("--check", help="compare with this committed JSON file")
     a = ap.parse_args(argv)
+    try:
+        return run(a)
+    except (OSError, ValueError) as e:  # a missing or unreadable dataset or reference file
+        print(f"gp_reference.py: error: {e}", file=sys.stderr)
+        return 2
+    except KeyError as e:
+        print(f"gp_reference.py: error: {a.check or a.campaign} has no entry {e}", file=sys.stderr)
+        return 2
+
+
+def run(a):
     r = reference(a.campaign)
     per = " / ".join(f"{k} {v:.4f}" for k, v in r["fit_by_location"].items())
     print(f"scikit-learn GP: held-out Fit {r['fit']:.4f} ({per}); {r['kernel']}")
     if a.out:
-        with open(a.out, "w") as f:
+        tmp = f"{a.out}.tmp"
+        with open(tmp, "w") as f:
             json.dump(r, f, indent=2)
             f.write("\n")
+        os.replace(tmp, a.out)  # never a half-written reference
         return 0
     with open(a.check) as f:
         want = json.load(f)

@@ -166,13 +166,17 @@ def probe_cv(d):
     for what, inner in sets.items():
         print(f"cv, {len(locs)} training locations, {what}, each left out in turn: "
               f"{' '.join(d.labels[l] for l in inner)}")
-        for name, per_newton in variants if inner else []:
-            truth = [d.y[d.loc == l] for l in inner]
+        if not inner:
+            continue
+        truth = [d.y[d.loc == l] for l in inner]
+        for name, per_newton in variants:
             pred = [predict(name, per_newton, d.tr & (d.loc != l), d.loc == l) for l in inner]
             per = [fit(t, p) for t, p in zip(truth, pred)]
             print(f"  GP {name} on {'Y / F' if per_newton else 'Y'}: Fit {fit(np.vstack(truth), np.vstack(pred)):.3f} "
                   f"(mean {np.mean(per):.3f}, worst {min(per):.3f})", flush=True)
-    for name, per_newton in variants if d.te.any() else []:
+    if not d.te.any():
+        return
+    for name, per_newton in variants:
         d.report(f"GP {name} on {'Y / F' if per_newton else 'Y'}, test locations", predict(name, per_newton, d.tr, d.te))
 
 
