@@ -21,11 +21,15 @@ above what `palpa train` gives on the same data.
   F F' k(x, x'), so that the stress vanishes with the force, as it does in the solver). Only
   training locations are used, so it can pick a model before anyone looks at A, B and C, and
   it runs on a campaign that is still going.
+- pca: the targets projected on their k leading principal components (k = 3, 6, 10, 20), one
+  GP per component with its own SE-ARD kernel (a model with a kernel per output direction
+  instead of one shared kernel), scored like `cv` on the interior training locations and on
+  the test locations.
 - shift: inverse-distance weighting of the 4 nearest training fields, each first shifted in plan
   by a fraction alpha of the offset between its hand and the test hand (alpha 0 = plain IDW),
   the shifted field read off with a 4 mm Gaussian kernel over the ROI centroids.
 
-    python surrogate/scripts/model_probes.py CAMPAIGN_DIR [gp] [gp-lolo] [pointwise] [shift] [cv]
+    python surrogate/scripts/model_probes.py CAMPAIGN_DIR [gp] [gp-lolo] [pointwise] [shift] [cv] [pca]
     (needs numpy, scipy and scikit-learn; the pointwise probe takes a few minutes)
 """
 import json
@@ -141,7 +145,9 @@ def gp_fit_predict(k, u, y, ut, f=None, ft=None):
     return (pred if f is None else pred * ft[:, None]), g
 
 
-def probe_cv(d):
+def cv_sets(d):
+    """The training locations the cv probes leave out: those with raster neighbours on all 4
+    sides, and those between two neighbours along x or y."""
     locs = list(np.unique(d.loc[d.tr]))
     xy = {l: d.x[d.loc == l][0, :2] for l in locs}
     step = np.array([np.diff(np.unique(np.round(d.x[d.tr, i], 6))).min() for i in (0, 1)])
@@ -152,10 +158,14 @@ def probe_cv(d):
     def between(l, axes):
         return [has(l, o) and has(l, (-o[0], -o[1])) for o in axes]
 
-    sets = {
+    return locs, {
         "interior (neighbours on 4 sides)": [l for l in locs if all(between(l, ((1, 0), (0, 1))))],
         "between two neighbours (along x or y)": [l for l in locs if any(between(l, ((1, 0), (0, 1))))],
     }
+
+
+def probe_cv(d):
+    locs, sets = cv_sets(d)
     ks = kernels()
     variants = [(name, per_newton) for name in ("SE", "Matern 5/2", "SE + SE") for per_newton in (False, True)]
 
@@ -178,6 +188,37 @@ def probe_cv(d):
         return
     for name, per_newton in variants:
         d.report(f"GP {name} on {'Y / F' if per_newton else 'Y'}, test locations", predict(name, per_newton, d.tr, d.te))
+
+
+def pca_gp_predict(u, y, ut, k):
+    """Y projected on its k leading principal components (over the training rows), one GP per
+    component with its own SE-ARD kernel by marginal likelihood, the rest left at the mean."""
+    from sklearn.gaussian_process import GaussianProcessRegressor as Gpr
+    from sklearn.gaussian_process.kernels import RBF, ConstantKernel, WhiteKernel
+
+    ym = y.mean(0)
+    _, _, vt = np.linalg.svd(y - ym, full_matrices=False)
+    z = (y - ym) @ vt[:k].T
+    pred = np.tile(ym, (len(ut), 1))
+    for j in range(k):
+        s = z[:, j].std()
+        kern = ConstantKernel(1.0) * RBF([1.0] * 3, (1e-2, 1e2)) + WhiteKernel(1e-2, (1e-8, 10.0))
+        g = Gpr(kern, n_restarts_optimizer=1, random_state=0).fit(u, z[:, j] / s)
+        pred += np.outer(g.predict(ut) * s, vt[j])
+    return pred
+
+
+def probe_pca(d):
+    _, sets = cv_sets(d)
+    inner = next(iter(sets.values()))
+    truth = [d.y[d.loc == l] for l in inner]
+    for k in (3, 6, 10, 20):
+        pred = [pca_gp_predict(d.u[d.tr & (d.loc != l)], d.y[d.tr & (d.loc != l)], d.u[d.loc == l], k)
+                for l in inner]
+        print(f"cv, interior, GP per principal component, k = {k}: Fit {fit(np.vstack(truth), np.vstack(pred)):.3f}",
+              flush=True)
+        if d.te.any():
+            d.report(f"GP per principal component, k = {k}", pca_gp_predict(d.u[d.tr], d.y[d.tr], d.u[d.te], k))
 
 
 def probe_pointwise(d):
@@ -237,7 +278,8 @@ def probe_shift(d):
 def main(argv):
     d = Data(argv[0])
     probes = argv[1:] or ["gp", "gp-lolo", "shift"]
-    table = {"gp": probe_gp, "gp-lolo": probe_gp_lolo, "pointwise": probe_pointwise, "shift": probe_shift, "cv": probe_cv}
+    table = {"gp": probe_gp, "gp-lolo": probe_gp_lolo, "pointwise": probe_pointwise, "shift": probe_shift,
+             "cv": probe_cv, "pca": probe_pca}
     for p in probes:
         table[p](d)
 
