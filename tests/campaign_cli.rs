@@ -9,7 +9,8 @@
 //!   redoes an unfinished run directory from scratch; without `--resume` it refuses to touch
 //!   the finished runs;
 //! - the shipped profiles (scenes/campaign-quick.toml, scenes/campaign-paper.toml,
-//!   scenes/campaign-5mm.toml, scenes/campaign-fbar-8mm.toml, scenes/campaign-wide-grid.toml)
+//!   scenes/campaign-5mm.toml, scenes/campaign-fbar-8mm.toml, scenes/campaign-wide-grid.toml,
+//!   scenes/campaign-convergence-2.5mm.toml)
 //!   resolve on their phantoms (`--dry-run`), the default raster covers the ROI's plan extent,
 //!   and a bad key is an error naming it.
 
@@ -327,6 +328,13 @@ fn shipped_profiles_resolve_and_bad_keys_are_named() {
     };
     assert_eq!(abc(&paper).len(), 3, "{paper}");
     assert_eq!(abc(&paper), abc(&wide));
+    // the mesh-convergence row: the default's P01..P04 at the same places on 2.5 mm voxels
+    let fine = dry_run("campaign-convergence-2.5mm.toml");
+    assert!(
+        fine.contains("4 runs (4 locations: 4 train, 0 test)") && fine.contains("voxel 2.5 mm"),
+        "{fine}"
+    );
+    assert_eq!(places(&fine), places(&paper)[..4].to_vec(), "{fine}");
 
     let tmp = tempfile::tempdir().unwrap();
     let bad = tmp.path().join("bad.toml");
