@@ -12,7 +12,12 @@ its 4 nearest elements), it prints:
   i.e. what bounds a surrogate trained on the raster (`idw_baseline.py` prints the same on the
   whole ROI of one campaign).
 
-    python surrogate/scripts/mesh_compare.py COARSE_DIR FINE_DIR [--radius 0.002]   (needs numpy, scipy)
+With `--smooth H` both fields are first averaged over their own ROI with a Gaussian of width H
+(m) and compared at the common-ground centroids: whether the field converges at a scale coarser
+than one element.
+
+    python surrogate/scripts/mesh_compare.py COARSE_DIR FINE_DIR [--radius 0.002] [--smooth 0.005]
+    (needs numpy, scipy)
 
 Example (3 mm default against the 2.5 mm row of `scenes/campaign-convergence-2.5mm.toml`):
     python surrogate/scripts/mesh_compare.py data/default-campaign-3mm results/convergence-2.5mm
@@ -58,6 +63,9 @@ def main(argv):
     ap.add_argument("coarse")
     ap.add_argument("fine")
     ap.add_argument("--radius", type=float, default=0.002, help="common ground: fine centroid within this distance (m)")
+    ap.add_argument("--smooth", type=float, default=0.0,
+                    help="compare Gaussian averages of each field over its own ROI, exp(-d^2 / h^2) with this h (m), "
+                         "instead of the element values: is a smoothed field converged?")
     a = ap.parse_args(argv)
     cs, fn = Campaign(a.coarse), Campaign(a.fine)
     shared = [l for l in fn.field if l in cs.field]
@@ -69,10 +77,18 @@ def main(argv):
     w = 1.0 / np.maximum(dist, 1e-12)
     w /= w.sum(1, keepdims=True)
 
+    def gauss(c, l):
+        q = cs.c[ground]
+        k = np.exp(-((q[:, None, :] - c.c[None]) ** 2).sum(2) / a.smooth**2)
+        return c.field[l] @ (k / k.sum(1, keepdims=True)).T
+
     def on_ground(c, l):
+        if a.smooth > 0:
+            return gauss(c, l)
         return c.field[l][:, ground] if c is cs else (fn.field[l][:, idx] * w[None]).sum(2)[:, ground]
 
-    print(f"ROI: coarse {len(cs.c)} elements, fine {len(fn.c)}; common ground {ground.sum()} coarse elements")
+    print(f"ROI: coarse {len(cs.c)} elements, fine {len(fn.c)}; common ground {ground.sum()} coarse elements"
+          + (f"; fields smoothed over h = {a.smooth * 1e3:g} mm" if a.smooth > 0 else ""))
     for l in shared:
         print(f"{l}: force coarse {np.round(cs.force[l], 1)} N, fine {np.round(fn.force[l], 1)} N; "
               f"peak ROI stress {cs.field[l].max() / 1e3:.2f} / {fn.field[l].max() / 1e3:.2f} kPa; "
