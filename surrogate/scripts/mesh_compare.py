@@ -23,28 +23,29 @@ Example (3 mm default against the 2.5 mm row of `scenes/campaign-convergence-2.5
     python surrogate/scripts/mesh_compare.py data/default-campaign-3mm results/convergence-2.5mm
 """
 import argparse
-import json
 import sys
 
 import numpy as np
 from scipy.spatial import cKDTree
 
 from idw_baseline import fit  # paper eq. 5, beside this script
+from model_probes import Data  # the dataset reader of the probes, beside this script
 
 
 class Campaign:
+    """One campaign's ROI centroids, and its fields, forces and hand positions by label."""
+
     def __init__(self, d):
         try:
-            z = np.load(f"{d}/dataset.npz")
-            with open(f"{d}/manifest.json") as f:
-                labels = json.load(f)["location_labels"]
+            z = Data(d)
         except (OSError, KeyError, ValueError) as e:
             print(f"error: {d}: {e}", file=sys.stderr)
             sys.exit(2)
-        self.c = z["roi_centroids"]
-        self.field = {labels[l]: z["Y"][z["location"] == l] for l in np.unique(z["location"])}
-        self.force = {labels[l]: z["X"][z["location"] == l][:, 2] for l in np.unique(z["location"])}
-        self.xy = {labels[l]: z["X"][z["location"] == l][0, :2] for l in np.unique(z["location"])}
+        self.c = z.c
+        locs = [(z.labels[l], z.loc == l) for l in np.unique(z.loc)]
+        self.field = {name: z.y[rows] for name, rows in locs}
+        self.force = {name: z.x[rows, 2] for name, rows in locs}
+        self.xy = {name: z.x[rows][0, :2] for name, rows in locs}
 
 
 def neighbours_x(c, label):

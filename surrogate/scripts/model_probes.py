@@ -194,7 +194,6 @@ def pca_gp_predict(u, y, ut, k):
     """Y projected on its k leading principal components (over the training rows), one GP per
     component with its own SE-ARD kernel by marginal likelihood, the rest left at the mean."""
     from sklearn.gaussian_process import GaussianProcessRegressor as Gpr
-    from sklearn.gaussian_process.kernels import RBF, ConstantKernel, WhiteKernel
 
     ym = y.mean(0)
     _, _, vt = np.linalg.svd(y - ym, full_matrices=False)
@@ -202,8 +201,7 @@ def pca_gp_predict(u, y, ut, k):
     pred = np.tile(ym, (len(ut), 1))
     for j in range(k):
         s = z[:, j].std()
-        kern = ConstantKernel(1.0) * RBF([1.0] * 3, (1e-2, 1e2)) + WhiteKernel(1e-2, (1e-8, 10.0))
-        g = Gpr(kern, n_restarts_optimizer=1, random_state=0).fit(u, z[:, j] / s)
+        g = Gpr(kernels()["SE"], n_restarts_optimizer=1, random_state=0).fit(u, z[:, j] / s)
         pred += np.outer(g.predict(ut) * s, vt[j])
     return pred
 
