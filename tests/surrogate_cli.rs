@@ -2,7 +2,8 @@
 //! MLP and the GP on a small synthetic dataset (model files written, Fit printed and finite),
 //! `palpa predict` one-shot with `--png` (vector of ROI length, PNG written) and `--stdin`
 //! (one JSON line per input, an error line for a malformed one), and bad input (missing
-//! dataset, missing model, wrong `--model`) giving a message naming it and a non-zero exit.
+//! dataset, missing model, wrong `--model`, `--target tensor` without stress tensors) giving a
+//! message naming it and a non-zero exit.
 
 use std::io::Write;
 use std::path::Path;
@@ -81,10 +82,13 @@ fn train_predict_and_stream() {
         &mlp,
         &["--epochs", "30", "--hidden", "16,16", "--seed", "3"],
     );
-    // GP: one start only; the synthetic field is smooth, the GP must get it
+    // GP: one start only; the synthetic field is smooth, the GP must get it. The dataset holds
+    // stress tensors, so the GP learns them by default and serves their largest eigenvalues
+    // (R values, checked below).
     let gp = dir.path().join("gp");
     let gp_out = train(&data, "gp", &gp, &["--restarts", "0"]);
     assert!(overall_fit(&gp_out) > 0.8, "{gp_out}");
+    assert!(gp_out.contains("model gp on the tensor target"), "{gp_out}");
 
     // one-shot with a map
     let png = dir.path().join("map.png");
@@ -189,6 +193,30 @@ fn bad_input_names_the_file_or_flag() {
     let err = text(&o.stderr);
     assert!(!o.status.success());
     assert!(err.contains("--model") && err.contains("svm"), "{err}");
+
+    // --target tensor on a dataset without stress tensors names S and the way out
+    let no_s = dir.path().join("no-s");
+    let mut d = surrogate::synthetic::make_synthetic_dataset(R);
+    d.stress = None;
+    d.write(&no_s).unwrap();
+    let o = palpa(&[
+        "train",
+        no_s.to_str().unwrap(),
+        "--model",
+        "gp",
+        "--target",
+        "tensor",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    let err = text(&o.stderr);
+    assert!(!o.status.success());
+    assert!(
+        err.contains(no_s.to_str().unwrap())
+            && err.contains("S")
+            && err.contains("--target principal"),
+        "{err}"
+    );
 
     // missing model, and a model file that is not one
     let o = palpa(&[

@@ -1,7 +1,14 @@
 //! Prediction latency of the surrogates on one core (issue 7 floors: MLP <= 50 us, GP <= 20 us),
-//! for the paper's ROI size R = 377 and the synthetic 150-sample training set.
+//! for the paper's ROI size R = 377:
+//! - on the synthetic 150-sample training set (`surrogate::synthetic`): the paper's MLP and the
+//!   GP on the principal stress (mean alone, and mean plus variance);
+//! - on the committed default campaign (`data/default-campaign-3mm`, 150 training samples): the
+//!   GP on the principal stress, and the GP on the stress tensor (6 x 377 outputs through its
+//!   output basis, then the largest eigenvalue of each of the 377 predicted tensors), the
+//!   default of `palpa train --model gp`. Each iteration is one whole prediction of all 377
+//!   maximum principal stresses.
 //!
-//! `cargo bench -p surrogate --bench surrogate`
+//! `cargo bench -p benches --bench surrogate`
 
 use criterion::{criterion_group, criterion_main, Criterion, Throughput};
 use std::hint::black_box;
@@ -9,7 +16,8 @@ use surrogate::gp::GpOptions;
 use surrogate::mlp::MlpOptions;
 use surrogate::model::PredictorImpl;
 use surrogate::synthetic::make_synthetic_dataset;
-use surrogate::{train_model, ModelKind, TrainOptions};
+use surrogate::target::TargetMap;
+use surrogate::{train_model, Dataset, ModelKind, Target, TrainOptions};
 
 fn predict_latency(c: &mut Criterion) {
     let data = make_synthetic_dataset(377);
@@ -23,6 +31,7 @@ fn predict_latency(c: &mut Criterion) {
             max_iterations: 50,
             ..Default::default()
         },
+        target: Some(Target::Principal),
     };
     let (mlp, _) = train_model(&data, ModelKind::Mlp, &opts).expect("train MLP");
     let (gp, _) = train_model(&data, ModelKind::Gp, &opts).expect("train GP");
@@ -40,6 +49,29 @@ fn predict_latency(c: &mut Criterion) {
     if let PredictorImpl::Gp(mut g) = gp.to_predictor() {
         group.bench_function("gp_mean_and_variance_n150_r377", |b| {
             b.iter(|| black_box(g.predict_with_variance(black_box(&inputs)).1))
+        });
+    }
+
+    let campaign =
+        std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../data/default-campaign-3mm");
+    let data = Dataset::read(&campaign).expect("read the committed default campaign");
+    let r = data.n_roi();
+    // a point between raster locations, at a mid-press force
+    let inputs = [data.x[(0, 0)] + 0.01, data.x[(0, 1)] + 0.006, 30.0];
+    for target in [Target::Principal, Target::Tensor] {
+        let opts = TrainOptions {
+            target: Some(target),
+            ..Default::default()
+        };
+        let (gp, report) = train_model(&data, ModelKind::Gp, &opts).expect("train GP");
+        eprintln!(
+            "default campaign, GP on the {target} target: {}",
+            report.size
+        );
+        let mut p = gp.to_predictor();
+        let mut map = TargetMap::new(target, r);
+        group.bench_function(format!("gp_{target}_default_campaign_r{r}"), |b| {
+            b.iter(|| black_box(map.apply(p.predict_inputs(black_box(&inputs)))[0]))
         });
     }
     group.finish();

@@ -31,8 +31,8 @@ pub struct EvaluateArgs {
     /// 2 cores, `--epochs 500` about 4 (and under-trains the MLPs).
     #[arg(long, default_value_t = surrogate::mlp::MlpOptions::default().epochs)]
     pub epochs: usize,
-    /// Only these configurations, comma-separated (gp, mlp-paper, mlp-medium, mlp-small)
-    /// [default: all].
+    /// Only these configurations, comma-separated (gp, gp-principal, mlp-paper, mlp-medium,
+    /// mlp-small) [default: all].
     #[arg(long, value_delimiter = ',')]
     pub models: Option<Vec<String>>,
 }
@@ -123,15 +123,16 @@ fn csv_field(s: &str) -> String {
 fn write_report(report: &EvaluationReport, dir: &Path) -> Result<Vec<String>, String> {
     std::fs::create_dir_all(dir).map_err(|e| format!("--out {}: {e}", dir.display()))?;
     let mut table = String::from(
-        "name,kind,size,n_params,fit_pooled,fit_mean,fit_min,train_seconds_per_fold,latency_us\n",
+        "name,kind,target,size,n_params,fit_pooled,fit_mean,fit_min,train_seconds_per_fold,latency_us\n",
     );
     let mut by_location = String::from("name,kind,location,label,n_samples,fit\n");
     for r in &report.rows {
         let _ = writeln!(
             table,
-            "{},{},{},{},{},{},{},{},{}",
+            "{},{},{},{},{},{},{},{},{},{}",
             csv_field(&r.name),
             r.kind,
+            r.target,
             csv_field(&r.size),
             r.n_params,
             r.fit_pooled,

@@ -101,16 +101,21 @@ pub fn predict_one(
     let (stress, variance) = p.predict_with_variance(x, y, force);
     let stress = stress.to_vec();
     let mut text = format!(
-        "{} model {} ({}): {} ROI elements\nfinger at x = {x} m, y = {y} m, force = {force} N\n",
+        "{} model {} on the {} target ({}): {} ROI elements\nfinger at x = {x} m, y = {y} m, force = {force} N\n",
         meta.kind,
         model.display(),
+        meta.target,
         meta.report.size,
         stress.len()
     );
     if let Some(v) = variance {
+        let of = match meta.target {
+            surrogate::Target::Principal => "all ROI elements",
+            surrogate::Target::Tensor => "every stress component of every ROI element",
+        };
         let _ = writeln!(
             text,
-            "GP predictive standard deviation (all ROI elements): {:.6e} Pa",
+            "GP predictive standard deviation ({of}): {:.6e} Pa",
             v.max(0.0).sqrt()
         );
     }

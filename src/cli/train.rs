@@ -9,7 +9,7 @@
 
 use surrogate::mlp::{AdamOptions, GdxOptions, Optimiser};
 use surrogate::model::model_paths;
-use surrogate::{ModelKind, TrainOptions};
+use surrogate::{ModelKind, Target, TrainOptions};
 
 use std::path::{Path, PathBuf};
 
@@ -40,6 +40,24 @@ pub enum OptimizerArg {
     Adam,
 }
 
+/// What the model learns, as `--target` spells it.
+#[derive(Clone, Copy, Debug, clap::ValueEnum)]
+pub enum TargetArg {
+    /// The ROI's maximum principal stress itself (the paper's target, Y).
+    Principal,
+    /// The ROI's six Cauchy stress components (S); predictions report their largest eigenvalue.
+    Tensor,
+}
+
+impl From<TargetArg> for Target {
+    fn from(t: TargetArg) -> Target {
+        match t {
+            TargetArg::Principal => Target::Principal,
+            TargetArg::Tensor => Target::Tensor,
+        }
+    }
+}
+
 /// `palpa train`'s arguments.
 #[derive(clap::Args)]
 pub struct TrainArgs {
@@ -53,6 +71,11 @@ pub struct TrainArgs {
     /// NAME.safetensors (beside NAME.json).
     #[arg(long)]
     pub out: PathBuf,
+    /// What the model learns [default: tensor for a GP on a dataset with stress tensors,
+    /// principal otherwise]. Either way it predicts, and is scored on, the ROI's maximum
+    /// principal stress.
+    #[arg(long, value_enum)]
+    pub target: Option<TargetArg>,
     /// MLP optimiser.
     #[arg(long, value_enum, default_value = "adam")]
     pub optimizer: OptimizerArg,
@@ -127,6 +150,7 @@ fn options(a: &TrainArgs) -> Result<TrainOptions, String> {
     if let Some(r) = a.restarts {
         opts.gp.restarts = r;
     }
+    opts.target = a.target.map(Target::from);
     Ok(opts)
 }
 
@@ -152,7 +176,14 @@ pub fn train(a: &TrainArgs) -> Result<(), String> {
             opts.gp.restarts, opts.gp.seed
         ),
     };
-    eprintln!("palpa train: {what} on {} ...", a.dataset.display());
+    let target = match a.target {
+        Some(t) => Target::from(t).to_string(),
+        None => "default".into(),
+    };
+    eprintln!(
+        "palpa train: {what}, {target} target, on {} ...",
+        a.dataset.display()
+    );
     let report = surrogate::train(&a.dataset, kind, &opts, &a.out)
         .map_err(|e| format!("train {}: {e}", a.dataset.display()))?;
     println!("Fit = 1 - sqrt(SSE / SST), paper eq. 5 (1 perfect, 0 no better than the mean)");

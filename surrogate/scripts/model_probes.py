@@ -25,11 +25,16 @@ above what `palpa train` gives on the same data.
   GP per component with its own SE-ARD kernel (a model with a kernel per output direction
   instead of one shared kernel), scored like `cv` on the interior training locations and on
   the test locations.
+- tensor: the GP as `palpa train --model gp --target tensor`: the same GP over the six Cauchy
+  components of every ROI element (`S`, 6R outputs sharing one kernel), the prediction's largest
+  eigenvalue per element scored against Y; scored like `cv` on the training locations (each
+  interior one, and each between two raster neighbours, left out in turn) next to the GP on Y,
+  then on the test locations.
 - shift: inverse-distance weighting of the 4 nearest training fields, each first shifted in plan
   by a fraction alpha of the offset between its hand and the test hand (alpha 0 = plain IDW),
   the shifted field read off with a 4 mm Gaussian kernel over the ROI centroids.
 
-    python surrogate/scripts/model_probes.py CAMPAIGN_DIR [gp] [gp-lolo] [pointwise] [shift] [cv] [pca]
+    python surrogate/scripts/model_probes.py CAMPAIGN_DIR [gp] [gp-lolo] [pointwise] [shift] [cv] [pca] [tensor]
     (needs numpy, scipy and scikit-learn; the pointwise probe takes a few minutes)
 """
 import json
@@ -50,6 +55,8 @@ class Data:
             self.labels = json.load(f)["location_labels"]
         self.x, self.y = z["X"][:, :3], z["Y"]
         self.loc, self.split, self.c = z["location"], z["split"], z["roi_centroids"]
+        # the stress tensors flattened element-major, n x 6R ([xx, yy, zz, xy, yz, zx] each)
+        self.s6 = z["S"].reshape(len(self.y), -1) if "S" in z.files else None
         self.tr, self.te = self.split == 0, self.split != 0
         self.mu, self.sd = self.x[self.tr].mean(0), self.x[self.tr].std(0)
         self.u = (self.x - self.mu) / self.sd
@@ -145,6 +152,22 @@ def gp_fit_predict(k, u, y, ut, f=None, ft=None):
     return (pred if f is None else pred * ft[:, None]), g
 
 
+def max_principal(s6):
+    """Largest eigenvalue per element of stress tensors flattened element-major (..., 6R)."""
+    s = s6.reshape(s6.shape[:-1] + (-1, 6))
+    m = np.empty(s.shape[:-1] + (3, 3))
+    for c, (i, j) in enumerate(((0, 0), (1, 1), (2, 2), (0, 1), (1, 2), (2, 0))):
+        m[..., i, j] = m[..., j, i] = s[..., c]
+    return np.linalg.eigvalsh(m)[..., -1]
+
+
+def tensor_gp_fit_predict(d, tr, te):
+    """The GP over the stress tensors of the rows `tr`, predicting the rows `te`; returns the
+    largest eigenvalue of the predicted tensor of every ROI element and the fitted regressor."""
+    pred, g = gp_fit_predict(kernels()["SE"], d.u[tr], d.s6[tr], d.u[te])
+    return max_principal(pred), g
+
+
 def cv_sets(d):
     """The training locations the cv probes leave out: those with raster neighbours on all 4
     sides, and those between two neighbours along x or y."""
@@ -219,6 +242,26 @@ def probe_pca(d):
             d.report(f"GP per principal component, k = {k}", pca_gp_predict(d.u[d.tr], d.y[d.tr], d.u[d.te], k))
 
 
+def probe_tensor(d):
+    if d.s6 is None:
+        print("tensor: the dataset holds no stress tensors (S)")
+        return
+    k = kernels()["SE"]
+    _, sets = cv_sets(d)
+    for what, inner in sets.items():
+        if not inner:
+            continue
+        truth = np.vstack([d.y[d.loc == l] for l in inner])
+        on_y = np.vstack([gp_fit_predict(k, d.u[d.tr & (d.loc != l)], d.y[d.tr & (d.loc != l)], d.u[d.loc == l])[0]
+                          for l in inner])
+        on_s = np.vstack([tensor_gp_fit_predict(d, d.tr & (d.loc != l), d.loc == l)[0] for l in inner])
+        print(f"cv, {what} ({len(inner)} locations), each left out in turn: GP on Y {fit(truth, on_y):.3f}, "
+              f"GP on S {fit(truth, on_s):.3f}", flush=True)
+    if d.te.any():
+        pred, g = tensor_gp_fit_predict(d, d.tr, d.te)
+        d.report(f"GP on S ({g.kernel_})", pred)
+
+
 def probe_pointwise(d):
     from sklearn.neural_network import MLPRegressor
 
@@ -277,7 +320,7 @@ def main(argv):
     d = Data(argv[0])
     probes = argv[1:] or ["gp", "gp-lolo", "shift"]
     table = {"gp": probe_gp, "gp-lolo": probe_gp_lolo, "pointwise": probe_pointwise, "shift": probe_shift,
-             "cv": probe_cv, "pca": probe_pca}
+             "cv": probe_cv, "pca": probe_pca, "tensor": probe_tensor}
     for p in probes:
         table[p](d)
 

@@ -7,6 +7,7 @@ use crate::gp::{fit_gp, GpOptions};
 use crate::mlp::{train_mlp, MlpOptions};
 use crate::model::{ModelKind, Predictor, PredictorImpl, TrainedModel};
 use crate::report::{CostRow, EvaluationReport, LocationFit, TrainReport};
+use crate::target::{Target, TargetMap};
 use ndarray::{s, Array2, Axis};
 use serde::{Deserialize, Serialize};
 use std::path::Path;
@@ -20,6 +21,9 @@ pub struct TrainOptions {
     pub mlp: MlpOptions,
     /// GP settings.
     pub gp: GpOptions,
+    /// What the model learns (`target`); `None` picks [`Target::default_for`] the model
+    /// family and dataset: the tensor for a GP on a dataset with `S`, else the principal stress.
+    pub target: Option<Target>,
 }
 
 /// One prediction: ROI stress and, for a GP, its variance.
@@ -108,7 +112,7 @@ pub fn evaluate(data: &Dataset, configs: &[ModelConfig]) -> Result<EvaluationRep
         let mut yhat_all = Vec::new();
         let mut by_location = Vec::new();
         let (mut secs, mut lat) = (0.0, 0.0);
-        let (mut size, mut n_params) = (String::new(), 0);
+        let (mut size, mut n_params, mut target) = (String::new(), 0, Target::default());
         for &loc in &locations {
             let mut fold = data.clone();
             fold.split = data.location.mapv(|l| u8::from(l == loc));
@@ -123,6 +127,7 @@ pub fn evaluate(data: &Dataset, configs: &[ModelConfig]) -> Result<EvaluationRep
             lat += report.latency_us;
             size = report.size.clone();
             n_params = report.n_params;
+            target = report.target;
         }
         let cat = |v: &[Array2<f64>]| {
             let views: Vec<_> = v.iter().map(|a| a.view()).collect();
@@ -135,6 +140,7 @@ pub fn evaluate(data: &Dataset, configs: &[ModelConfig]) -> Result<EvaluationRep
         rows.push(CostRow {
             name: cfg.name.clone(),
             kind: cfg.kind,
+            target,
             size,
             n_params,
             fit_pooled: compute_fit(y.view(), yhat.view()),
@@ -151,8 +157,9 @@ pub fn evaluate(data: &Dataset, configs: &[ModelConfig]) -> Result<EvaluationRep
     })
 }
 
-/// The default table of `evaluate`: the GP, the paper's MLP, and two smaller MLPs, all trained
-/// with Adam for `mlp_epochs` epochs.
+/// The default table of `evaluate`: the GP (on the stress tensor when the dataset has it), the
+/// GP on the principal stress, the paper's MLP, and two smaller MLPs, all trained with Adam for
+/// `mlp_epochs` epochs.
 pub fn default_evaluation_configs(mlp_epochs: usize) -> Vec<ModelConfig> {
     let mlp = |name: &str, hidden: &[usize]| ModelConfig {
         name: name.into(),
@@ -164,6 +171,7 @@ pub fn default_evaluation_configs(mlp_epochs: usize) -> Vec<ModelConfig> {
                 ..Default::default()
             },
             gp: GpOptions::default(),
+            target: None,
         },
     };
     vec![
@@ -171,6 +179,14 @@ pub fn default_evaluation_configs(mlp_epochs: usize) -> Vec<ModelConfig> {
             name: "gp".into(),
             kind: ModelKind::Gp,
             options: TrainOptions::default(),
+        },
+        ModelConfig {
+            name: "gp-principal".into(),
+            kind: ModelKind::Gp,
+            options: TrainOptions {
+                target: Some(Target::Principal),
+                ..Default::default()
+            },
         },
         mlp("mlp-paper", &crate::mlp::PAPER_HIDDEN),
         mlp("mlp-medium", &[32, 64, 128]),
@@ -192,7 +208,10 @@ fn fit_and_score(
     }
     let x3 = data.x.slice(s![.., 0..3]);
     let xt = x3.select(Axis(0), &train_rows);
-    let yt = data.y.select(Axis(0), &train_rows);
+    let target = opts
+        .target
+        .unwrap_or_else(|| Target::default_for(kind, data));
+    let yt = target.training_targets(data, &train_rows)?;
     let start = Instant::now();
     let (model, epochs, objective, size, n_params, settings) = match kind {
         ModelKind::Mlp => {
@@ -210,24 +229,36 @@ fn fit_and_score(
         }
         ModelKind::Gp => {
             let g = fit_gp(xt.view(), yt.view(), &opts.gp)?;
+            let basis = g.basis.as_ref().map_or(String::new(), |b| {
+                format!(
+                    ", output basis of {} of {} directions (drops {:.1e})",
+                    b.nrows(),
+                    b.ncols(),
+                    g.dropped_energy
+                )
+            });
             let size = format!(
-                "SE-ARD, n={} ({} in the likelihood)",
+                "SE-ARD, n={} ({} in the likelihood){basis}",
                 g.train_inputs.nrows(),
                 g.likelihood_rows
             );
-            let (l, np) = (g.log_marginal_likelihood, g.alpha.len());
+            let np = g.coef.len() + g.basis.as_ref().map_or(0, |b| b.len());
+            let l = g.log_marginal_likelihood;
             let set = serde_json::to_value(&opts.gp).unwrap_or_default();
             (TrainedModel::Gp(g), None, l, size, np, set)
         }
     };
     let train_seconds = start.elapsed().as_secs_f64();
     let mut pred = model.to_predictor();
+    let mut map = TargetMap::new(target, data.n_roi());
     let mut yhat = Array2::zeros(data.y.dim());
     for (i, mut row) in yhat.rows_mut().into_iter().enumerate() {
         let xi = [x3[(i, 0)], x3[(i, 1)], x3[(i, 2)]];
-        row.assign(&ndarray::ArrayView1::from(pred.predict_inputs(&xi)));
+        row.assign(&ndarray::ArrayView1::from(
+            map.apply(pred.predict_inputs(&xi)),
+        ));
     }
-    let latency_us = measure_latency(&mut pred, &x3.select(Axis(0), &train_rows));
+    let latency_us = measure_latency(&mut pred, &mut map, &x3.select(Axis(0), &train_rows));
     let score = |rows: &[usize]| {
         compute_fit(
             data.y.select(Axis(0), rows).view(),
@@ -256,6 +287,7 @@ fn fit_and_score(
     };
     let report = TrainReport {
         kind,
+        target,
         size,
         n_params,
         n_train: train_rows.len(),
@@ -272,8 +304,9 @@ fn fit_and_score(
     Ok((model, report, yhat))
 }
 
-/// Mean latency [us] of one prediction over the rows of `inputs`, cycled for at least 2000 calls.
-fn measure_latency(pred: &mut PredictorImpl, inputs: &Array2<f64>) -> f64 {
+/// Mean latency [us] of one prediction (raw outputs mapped to the principal stress) over the
+/// rows of `inputs`, cycled for at least 2000 calls.
+fn measure_latency(pred: &mut PredictorImpl, map: &mut TargetMap, inputs: &Array2<f64>) -> f64 {
     let n = inputs.nrows().max(1);
     let calls = 2000usize;
     let start = Instant::now();
@@ -281,7 +314,11 @@ fn measure_latency(pred: &mut PredictorImpl, inputs: &Array2<f64>) -> f64 {
     for k in 0..calls {
         let i = k % n;
         let xi = [inputs[(i, 0)], inputs[(i, 1)], inputs[(i, 2)]];
-        sink += pred.predict_inputs(&xi).first().copied().unwrap_or(0.0);
+        sink += map
+            .apply(pred.predict_inputs(&xi))
+            .first()
+            .copied()
+            .unwrap_or(0.0);
     }
     std::hint::black_box(sink);
     start.elapsed().as_secs_f64() * 1e6 / calls as f64

@@ -11,6 +11,8 @@
 //!   forward pass.
 //! - [`gp`]: a Gaussian process with one SE-ARD kernel shared by all outputs, hyperparameters
 //!   by marginal likelihood, predictive variance.
+//! - [`target`]: what a model learns, the principal stress itself or the stress tensor whose
+//!   largest eigenvalue ([`principal`]) it reports.
 //! - [`fit`]: paper eq. 5, per location and overall.
 //! - [`model`]: safetensors + JSON model files and the serving [`Predictor`].
 //! - [`api`]: [`train`], [`predict`], [`evaluate`] for the command line; [`render_map`] for PNG maps.
@@ -29,10 +31,12 @@ pub mod lbfgs;
 pub mod mlp;
 pub mod model;
 pub mod normalise;
+pub mod principal;
 pub mod render;
 pub mod report;
 pub mod rng;
 pub mod synthetic;
+pub mod target;
 pub mod tensor_file;
 
 pub use api::{
@@ -45,3 +49,4 @@ pub use fit::{compute_fit, compute_fit_by_location};
 pub use model::{ModelKind, ModelMeta, Predictor, TrainedModel};
 pub use render::render_map;
 pub use report::{CostRow, EvaluationReport, LocationFit, TrainReport};
+pub use target::Target;

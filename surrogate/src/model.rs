@@ -7,9 +7,13 @@
 //! Tensors (row-major):
 //! - MLP: `layers.L.weight` `[n_out, n_in]` f32 (the PyTorch `nn.Linear` layout) and
 //!   `layers.L.bias` `[n_out]` f32, for L = 0 .. layers-1; normalised units (see `normalise`).
-//! - GP: `train_inputs` `[n, D]`, `alpha` `[n, R]` (= K^-1 V), `k_inv` `[n, n]`, all f64,
-//!   normalised units.
+//! - GP: `train_inputs` `[n, D]`, `coef` `[n, r]`, `basis` `[r, M]` (the mean's output basis,
+//!   see `gp::train`; without `basis`, `coef` is `[n, M]` = K^-1 V), `k_inv` `[n, n]`, all
+//!   f64, normalised units. Version-1 files name `coef` `alpha` and have no basis.
 //! - Both: `roi_centroids` `[R, 3]` f64 [m], for rendering maps from the model alone.
+//!
+//! M is the number of raw outputs: R for the principal-stress target, 6R for the tensor target
+//! (`target`); [`Predictor`] always serves the R maximum principal stresses.
 
 use crate::dataset::write_atomic;
 use crate::error::{Error, Result};
@@ -17,6 +21,7 @@ use crate::gp::{GpModel, GpPredictor, SeArd};
 use crate::mlp::{DenseLayer, MlpModel, MlpPredictor};
 use crate::normalise::Scaling;
 use crate::report::TrainReport;
+use crate::target::{Target, TargetMap};
 use crate::tensor_file::{
     read_tensors, take_f32, take_f64, write_tensors, Tensor, TensorData, TensorSet,
 };
@@ -28,7 +33,7 @@ use std::path::{Path, PathBuf};
 /// Value of [`ModelMeta::format`].
 pub const MODEL_FORMAT: &str = "palpa-surrogate";
 /// Current value of [`ModelMeta::version`].
-pub const MODEL_VERSION: u32 = 1;
+pub const MODEL_VERSION: u32 = 2;
 
 /// The surrogate families.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
@@ -68,13 +73,16 @@ impl std::str::FromStr for ModelKind {
 pub struct ModelMeta {
     /// Always `"palpa-surrogate"`.
     pub format: String,
-    /// Format version, currently 1.
+    /// Format version, currently 2.
     pub version: u32,
     /// Model family.
     pub kind: ModelKind,
+    /// What the raw outputs stand for; absent (version 1) means the principal stress.
+    #[serde(default)]
+    pub target: Target,
     /// Names of the inputs, in order (`x`, `y`, `force`); units m, m, N.
     pub input_columns: Vec<String>,
-    /// ROI element ids of the outputs, in order; outputs are maximum principal stress [Pa].
+    /// ROI element ids, in order; the served outputs are their maximum principal stress [Pa].
     pub roi_ids: Vec<i64>,
     /// Input scaling (physical -> normalised).
     pub input_scaling: Scaling,
@@ -120,7 +128,7 @@ impl TrainedModel {
         }
     }
 
-    /// Number of outputs R.
+    /// Number of raw outputs M (R or 6R, see the module doc).
     pub fn n_outputs(&self) -> usize {
         match self {
             TrainedModel::Mlp(m) => m.output_scaling.len(),
@@ -152,13 +160,18 @@ impl TrainedModel {
                 g.input_scaling.clone(),
                 g.output_scaling.clone(),
                 &g.train_inputs.iter().copied().collect::<Vec<_>>(),
-                g.alpha.iter().copied().collect(),
+                g.coef.iter().copied().collect(),
+                g.basis
+                    .as_ref()
+                    .map(|b| b.iter().copied().collect())
+                    .unwrap_or_default(),
                 g.k_inv.iter().copied().collect(),
             )),
         }
     }
 
-    /// Saves the model with its ROI (ids, centroids R x 3 [m]) and training report.
+    /// Saves the model with its ROI (ids, centroids R x 3 [m]) and training report (whose
+    /// `target` says what the outputs stand for).
     pub fn save(
         &self,
         path: impl AsRef<Path>,
@@ -170,14 +183,15 @@ impl TrainedModel {
         if let Some(dir) = st.parent().filter(|d| !d.as_os_str().is_empty()) {
             std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, e))?;
         }
-        let r = self.n_outputs();
-        if roi_ids.len() != r || roi_centroids.dim() != (r, 3) {
+        let m = self.n_outputs();
+        let r = roi_ids.len();
+        if report.target.n_outputs(r) != m || roi_centroids.dim() != (r, 3) {
             return Err(Error::invalid(
                 "roi",
                 format!(
-                    "{} ids and centroids {:?} for a model of {r} outputs",
-                    roi_ids.len(),
-                    roi_centroids.dim()
+                    "{r} ids and centroids {:?} for a model of {m} outputs on the {} target",
+                    roi_centroids.dim(),
+                    report.target
                 ),
             ));
         }
@@ -235,7 +249,10 @@ impl TrainedModel {
                     );
                 };
                 put(&mut set, "train_inputs", &g.train_inputs);
-                put(&mut set, "alpha", &g.alpha);
+                put(&mut set, "coef", &g.coef);
+                if let Some(b) = &g.basis {
+                    put(&mut set, "basis", b);
+                }
                 put(&mut set, "k_inv", &g.k_inv);
                 (
                     g.input_scaling.clone(),
@@ -250,6 +267,7 @@ impl TrainedModel {
             format: MODEL_FORMAT.into(),
             version: MODEL_VERSION,
             kind: self.kind(),
+            target: report.target,
             input_columns: vec!["x".into(), "y".into(), "force".into()],
             roi_ids: roi_ids.to_vec(),
             input_scaling,
@@ -293,6 +311,7 @@ pub struct Predictor {
     meta: ModelMeta,
     roi_centroids: Array2<f64>,
     inner: PredictorImpl,
+    map: TargetMap,
 }
 
 impl Predictor {
@@ -312,14 +331,17 @@ impl Predictor {
             ));
         }
         let r = meta.roi_ids.len();
+        let m = meta.target.n_outputs(r);
         let d = meta.input_columns.len();
-        if meta.input_scaling.len() != d || meta.output_scaling.len() != r {
+        if meta.input_scaling.len() != d || meta.output_scaling.len() != m {
             return Err(Error::format(
                 &js,
                 format!(
-                    "input_scaling has {} columns for {d} inputs, output_scaling {} for {r} ROI ids",
+                    "input_scaling has {} columns for {d} inputs, output_scaling {} for {r} ROI ids \
+                     ({m} outputs on the {} target)",
                     meta.input_scaling.len(),
-                    meta.output_scaling.len()
+                    meta.output_scaling.len(),
+                    meta.target
                 ),
             ));
         }
@@ -330,10 +352,10 @@ impl Predictor {
         let inner = match meta.kind {
             ModelKind::Mlp => {
                 let s = &meta.layer_sizes;
-                if s.len() < 2 || s[0] != d || s[s.len() - 1] != r {
+                if s.len() < 2 || s[0] != d || s[s.len() - 1] != m {
                     return Err(Error::format(
                         &js,
-                        format!("layer_sizes {s:?} do not match {d} inputs and {r} outputs"),
+                        format!("layer_sizes {s:?} do not match {d} inputs and {m} outputs"),
                     ));
                 }
                 let mut layers = Vec::new();
@@ -376,41 +398,53 @@ impl Predictor {
                     .map(|t| t.shape.first().copied().unwrap_or(0))
                     .ok_or_else(|| Error::format(&st, "missing tensor train_inputs"))?;
                 let u = take_f64(&mut set, &st, "train_inputs", &[n, d])?;
-                let alpha = take_f64(&mut set, &st, "alpha", &[n, r])?;
+                let (coef, basis) = if meta.version < 2 {
+                    (take_f64(&mut set, &st, "alpha", &[n, m])?, Vec::new())
+                } else if let Some(rank) = set.get("basis").and_then(|t| t.shape.first().copied()) {
+                    let b = take_f64(&mut set, &st, "basis", &[rank, m])?;
+                    (take_f64(&mut set, &st, "coef", &[n, rank])?, b)
+                } else {
+                    (take_f64(&mut set, &st, "coef", &[n, m])?, Vec::new())
+                };
                 let k_inv = take_f64(&mut set, &st, "k_inv", &[n, n])?;
                 PredictorImpl::Gp(GpPredictor::new(
                     kernel,
                     meta.input_scaling.clone(),
                     meta.output_scaling.clone(),
                     &u,
-                    alpha,
+                    coef,
+                    basis,
                     k_inv,
                 ))
             }
         };
+        let map = TargetMap::new(meta.target, r);
         Ok(Predictor {
             meta,
             roi_centroids,
             inner,
+            map,
         })
     }
 
     /// ROI maximum principal stress [Pa] for a finger at (`x`, `y`) [m] pressing with `force` [N].
     /// Allocation-free; the slice is valid until the next call.
     pub fn predict(&mut self, x: f64, y: f64, force: f64) -> &[f64] {
-        self.inner.predict_inputs(&[x, y, force])
+        self.map.apply(self.inner.predict_inputs(&[x, y, force]))
     }
 
     /// Like [`Predictor::predict`], plus the GP's predictive (latent) variance [Pa^2], shared
-    /// by all ROI elements; `None` for an MLP. Costs a little more than the mean alone.
+    /// by all raw outputs (for a tensor target, by every stress component); `None` for an MLP.
+    /// Costs a little more than the mean alone.
     pub fn predict_with_variance(&mut self, x: f64, y: f64, force: f64) -> (&[f64], Option<f64>) {
-        match &mut self.inner {
+        let (raw, var) = match &mut self.inner {
             PredictorImpl::Gp(g) => {
                 let (m, v) = g.predict_with_variance(&[x, y, force]);
                 (m, Some(v))
             }
             PredictorImpl::Mlp(m) => (m.predict_inputs(&[x, y, force]), None),
-        }
+        };
+        (self.map.apply(raw), var)
     }
 
     /// The model's metadata (kind, architecture, training report, ...).

@@ -2,6 +2,7 @@
 //! and the accuracy-versus-cost table.
 
 use crate::model::ModelKind;
+use crate::target::Target;
 use serde::{Deserialize, Serialize};
 use std::fmt;
 
@@ -23,9 +24,13 @@ pub struct LocationFit {
 pub struct TrainReport {
     /// Model family.
     pub kind: ModelKind,
+    /// What the outputs stand for (`target`); models saved before it existed learned `Y`.
+    #[serde(default)]
+    pub target: Target,
     /// Architecture in words, e.g. `3-64-126-256-512-377` or `SE-ARD, n=150`.
     pub size: String,
-    /// Number of stored parameters (weights and biases; for a GP, the entries of alpha).
+    /// Number of stored parameters (weights and biases; for a GP, the entries of its mean's
+    /// coefficients and output basis).
     pub n_params: usize,
     /// Training samples.
     pub n_train: usize,
@@ -54,8 +59,9 @@ impl fmt::Display for TrainReport {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         writeln!(
             f,
-            "model {} ({}, {} parameters), {} training samples, trained in {:.2} s{}",
+            "model {} on the {} target ({}, {} parameters), {} training samples, trained in {:.2} s{}",
             self.kind,
+            self.target,
             self.size,
             self.n_params,
             self.n_train,
@@ -88,6 +94,9 @@ pub struct CostRow {
     pub name: String,
     /// Model family.
     pub kind: ModelKind,
+    /// What the outputs stand for (`target`); models saved before it existed learned `Y`.
+    #[serde(default)]
+    pub target: Target,
     /// Architecture in words.
     pub size: String,
     /// Stored parameters.
@@ -124,15 +133,16 @@ impl fmt::Display for EvaluationReport {
         )?;
         writeln!(
             f,
-            "| model | kind | size | params | Fit pooled | Fit mean | Fit min | train s/fold | latency us |"
+            "| model | kind | target | size | params | Fit pooled | Fit mean | Fit min | train s/fold | latency us |"
         )?;
-        writeln!(f, "|---|---|---|---:|---:|---:|---:|---:|---:|")?;
+        writeln!(f, "|---|---|---|---|---:|---:|---:|---:|---:|---:|")?;
         for r in &self.rows {
             writeln!(
                 f,
-                "| {} | {} | {} | {} | {:.4} | {:.4} | {:.4} | {:.2} | {:.1} |",
+                "| {} | {} | {} | {} | {} | {:.4} | {:.4} | {:.4} | {:.2} | {:.1} |",
                 r.name,
                 r.kind,
+                r.target,
                 r.size,
                 r.n_params,
                 r.fit_pooled,

@@ -11,9 +11,14 @@
 //!
 //! with `c = 60 Pa/N^1.2`, `w1 = 35 mm`, `w2 = 70 mm` (wider than the 22.5 mm grid spacing, so the grid resolves the field): tension under the finger, compression
 //! around it, a few kPa at 37 N, as in the paper's range (-4.7 to +3.8 kPa).
+//!
+//! The stress tensor `S` of each element has principal stresses `y_r`, `y_r - 20 F^1.2` and
+//! `y_r - 45 F^1.2` (Pa), the first two in the x-y plane turned by
+//! `phi = 10 (p_x - x_r) + 5 (p_y - y_r)` radians about z, so its largest eigenvalue is `y_r`
+//! exactly and its components turn as the finger moves.
 
 use crate::dataset::{Dataset, Manifest};
-use ndarray::{Array1, Array2};
+use ndarray::{Array1, Array2, Array3};
 
 /// Force levels [N] of every location (the paper's platform saw about 6, 27 and 37 N).
 pub const FORCES: [f64; 6] = [0.0, 6.0, 14.0, 22.0, 29.0, 37.0];
@@ -29,6 +34,24 @@ pub fn compute_stress(cx: f64, cy: f64, px: f64, py: f64, force: f64) -> f64 {
     60.0 * force.max(0.0).powf(1.2)
         * ((-d2 / (2.0 * w1 * w1)).exp() - 0.35 * (-d2 / (2.0 * w2 * w2)).exp())
         * (1.0 + 0.15 * (20.0 * cx).sin())
+}
+
+/// The stress tensor `[xx, yy, zz, xy, yz, zx]` [Pa] of an element at `(cx, cy)` [m] for a
+/// finger at `(px, py)` [m] pressing with `force` [N] (module doc); its largest eigenvalue is
+/// [`compute_stress`].
+pub fn compute_stress_tensor(cx: f64, cy: f64, px: f64, py: f64, force: f64) -> [f64; 6] {
+    let y = compute_stress(cx, cy, px, py, force);
+    let f = force.max(0.0).powf(1.2);
+    let (a, b) = (20.0 * f, 45.0 * f);
+    let (s, c) = (10.0 * (px - cx) + 5.0 * (py - cy)).sin_cos();
+    [
+        y * c * c + (y - a) * s * s,
+        y * s * s + (y - a) * c * c,
+        y - b,
+        a * c * s,
+        0.0,
+        0.0,
+    ]
 }
 
 /// The synthetic dataset with `r` ROI elements: 25 grid locations (split 0) then A, B, C
@@ -53,6 +76,7 @@ pub fn make_synthetic_dataset(r: usize) -> Dataset {
     let n = locs.len() * FORCES.len();
     let mut x = Array2::zeros((n, 4));
     let mut y = Array2::zeros((n, r));
+    let mut stress = Array3::zeros((n, r, 6));
     let mut location = Array1::zeros(n);
     let mut split = Array1::zeros(n);
     for (li, &(px, py)) in locs.iter().enumerate() {
@@ -63,7 +87,14 @@ pub fn make_synthetic_dataset(r: usize) -> Dataset {
             x[(i, 2)] = f;
             x[(i, 3)] = 0.005 * k as f64;
             for e in 0..r {
-                y[(i, e)] = compute_stress(centroids[(e, 0)], centroids[(e, 1)], px, py, f);
+                let (cx, cy) = (centroids[(e, 0)], centroids[(e, 1)]);
+                y[(i, e)] = compute_stress(cx, cy, px, py, f);
+                for (k, v) in compute_stress_tensor(cx, cy, px, py, f)
+                    .into_iter()
+                    .enumerate()
+                {
+                    stress[(i, e, k)] = v;
+                }
             }
             location[i] = li as i64;
             split[i] = u8::from(li >= 25);
@@ -81,7 +112,7 @@ pub fn make_synthetic_dataset(r: usize) -> Dataset {
     Dataset {
         x,
         y,
-        stress: None,
+        stress: Some(stress),
         roi_ids: (0..r as i64).map(|i| 1000 + i).collect(),
         roi_centroids: centroids,
         location,

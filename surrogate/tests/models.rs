@@ -1,5 +1,6 @@
 //! Both surrogates on the synthetic dataset (`surrogate::synthetic`): accuracy on the held-out
-//! locations, save/load, and the serving forward pass against the trainer's.
+//! locations, save/load (on both targets), the serving forward pass against the trainer's, and
+//! the tensor target's served value against nalgebra's eigenvalues of its predicted tensor.
 //!
 //! Threshold: Fit > 0.9 on the three held-out locations, the floor (the paper reached
 //! 0.9264). It is meaningful here because a model that ignores where the finger is scores far
@@ -11,7 +12,10 @@ use surrogate::gp::GpOptions;
 use surrogate::mlp::network::{forward_batch, BatchWorkspace};
 use surrogate::mlp::{AdamOptions, GdxOptions, MlpOptions, Optimiser};
 use surrogate::synthetic::{make_synthetic_dataset, FORCES};
-use surrogate::{compute_fit, train_model, ModelKind, Predictor, TrainOptions, TrainedModel};
+use surrogate::target::TargetMap;
+use surrogate::{
+    compute_fit, train_model, ModelKind, Predictor, Target, TrainOptions, TrainedModel,
+};
 
 const R: usize = 40;
 const FLOOR: f64 = 0.9;
@@ -28,6 +32,7 @@ fn mlp_options(epochs: usize) -> TrainOptions {
             ..Default::default()
         },
         gp: GpOptions::default(),
+        target: None,
     }
 }
 
@@ -143,11 +148,64 @@ fn assert_round_trip(kind: ModelKind, opts: &TrainOptions) {
     assert_eq!(loaded.meta().report, report);
     assert_eq!(loaded.roi_centroids(), d.roi_centroids.view());
     let mut direct = model.to_predictor();
+    let mut map = TargetMap::new(report.target, R);
     for i in [0, 37, 160] {
         let (x, y, f) = (d.x[(i, 0)], d.x[(i, 1)], d.x[(i, 2)]);
-        let a = direct.predict_inputs(&[x, y, f]).to_vec();
+        let a = map.apply(direct.predict_inputs(&[x, y, f])).to_vec();
+        assert_eq!(a.len(), R);
         assert_eq!(loaded.predict(x, y, f), &a[..], "row {i}");
     }
+}
+
+#[test]
+fn gp_on_the_stress_tensor_serves_the_largest_eigenvalue_of_its_prediction() {
+    let d = make_synthetic_dataset(R);
+    let (model, report) = train_model(&d, ModelKind::Gp, &gp_options()).unwrap();
+    // the synthetic dataset has S, so the GP's default target is the tensor
+    assert_eq!(report.target, Target::Tensor);
+    assert!(report.test_fit.unwrap() > FLOOR, "{report}");
+    let mut raw = model.to_predictor();
+    let mut map = TargetMap::new(Target::Tensor, R);
+    for i in d.rows_with_split(1) {
+        let s6 = raw
+            .predict_inputs(&[d.x[(i, 0)], d.x[(i, 1)], d.x[(i, 2)]])
+            .to_vec();
+        assert_eq!(s6.len(), 6 * R);
+        let served = map.apply(&s6).to_vec();
+        for (e, s) in s6.chunks_exact(6).enumerate() {
+            let want = nalgebra::Matrix3::new(s[0], s[3], s[5], s[3], s[1], s[4], s[5], s[4], s[2])
+                .symmetric_eigenvalues()
+                .max();
+            assert!(
+                (served[e] - want).abs() <= 1e-9 * (1.0 + want.abs()),
+                "row {i} element {e}: {} against {want}",
+                served[e]
+            );
+        }
+    }
+    // without S the tensor target is an error naming S
+    let mut no_s = d.clone();
+    no_s.stress = None;
+    let opts = TrainOptions {
+        target: Some(Target::Tensor),
+        ..gp_options()
+    };
+    let err = train_model(&no_s, ModelKind::Gp, &opts)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        err.contains("S") && err.contains("--target principal"),
+        "{err}"
+    );
+}
+
+#[test]
+fn tensor_gp_save_load_round_trip_predicts_identically() {
+    let mut o = gp_options();
+    o.target = Some(Target::Tensor);
+    o.gp.restarts = 0;
+    o.gp.max_iterations = 20;
+    assert_round_trip(ModelKind::Gp, &o);
 }
 
 #[test]
@@ -158,6 +216,7 @@ fn mlp_save_load_round_trip_predicts_identically() {
 #[test]
 fn gp_save_load_round_trip_predicts_identically() {
     let mut o = gp_options();
+    o.target = Some(Target::Principal);
     o.gp.restarts = 0;
     o.gp.max_iterations = 20;
     assert_round_trip(ModelKind::Gp, &o);
@@ -227,6 +286,8 @@ fn bad_inputs_are_errors_not_panics() {
 #[test]
 fn gp_with_repeated_unloaded_rows_and_noisy_targets_keeps_a_noise_term() {
     let mut d = make_synthetic_dataset(R);
+    // the noise goes on Y; without S the GP's default target is Y
+    d.stress = None;
     let train = d.rows_with_split(0);
     let rms = (train
         .iter()
