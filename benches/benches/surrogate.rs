@@ -5,8 +5,9 @@
 //! - on the committed default campaign (`data/default-campaign-3mm`, 150 training samples): the
 //!   GP on the principal stress, and the GP on the stress tensor (6 x 377 outputs through its
 //!   output basis, then the largest eigenvalue of each of the 377 predicted tensors), the
-//!   default of `palpa train --model gp`. Each iteration is one whole prediction of all 377
-//!   maximum principal stresses.
+//!   default of `palpa train --model gp`, with its output basis and without (`_exact`: every
+//!   output direction, the accuracy-versus-latency knob `GpOptions::output_tolerance`). Each
+//!   iteration is one whole prediction of all 377 maximum principal stresses.
 //!
 //! `cargo bench -p benches --bench surrogate`
 
@@ -58,19 +59,29 @@ fn predict_latency(c: &mut Criterion) {
     let r = data.n_roi();
     // a point between raster locations, at a mid-press force
     let inputs = [data.x[(0, 0)] + 0.01, data.x[(0, 1)] + 0.006, 30.0];
-    for target in [Target::Principal, Target::Tensor] {
+    let exact = GpOptions {
+        output_tolerance: 0.0,
+        ..Default::default()
+    };
+    for (target, gp_opts, name) in [
+        (Target::Principal, GpOptions::default(), ""),
+        (Target::Tensor, GpOptions::default(), ""),
+        (Target::Tensor, exact, "_exact"),
+    ] {
         let opts = TrainOptions {
             target: Some(target),
+            gp: gp_opts,
             ..Default::default()
         };
         let (gp, report) = train_model(&data, ModelKind::Gp, &opts).expect("train GP");
         eprintln!(
-            "default campaign, GP on the {target} target: {}",
-            report.size
+            "default campaign, GP on the {target} target{name}: {}, held-out Fit {:.4}",
+            report.size,
+            report.test_fit.unwrap_or(f64::NAN)
         );
         let mut p = gp.to_predictor();
         let mut map = TargetMap::new(target, r);
-        group.bench_function(format!("gp_{target}_default_campaign_r{r}"), |b| {
+        group.bench_function(format!("gp_{target}{name}_default_campaign_r{r}"), |b| {
             b.iter(|| black_box(map.apply(p.predict_inputs(black_box(&inputs)))[0]))
         });
     }

@@ -27,7 +27,7 @@ pub struct EvaluateArgs {
     #[arg(long)]
     pub out: Option<PathBuf>,
     /// MLP epochs per fold (Adam), by default those of `palpa train`. Every configuration is
-    /// trained once per location: with 28 locations the default table takes about 13 minutes on
+    /// trained once per location: with 28 locations the default table takes about 8 minutes on
     /// 2 cores, `--epochs 500` about 4 (and under-trains the MLPs).
     #[arg(long, default_value_t = surrogate::mlp::MlpOptions::default().epochs)]
     pub epochs: usize,

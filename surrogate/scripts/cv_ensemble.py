@@ -8,7 +8,10 @@ the blend w MLP + (1 - w) GP for w = 0, 0.25, 0.5, 0.75, 1, over the interior lo
 over those between two neighbours. It asks whether averaging the two model classes, chosen
 without the test locations, would beat the GP alone.
 
-    python surrogate/scripts/cv_ensemble.py CAMPAIGN_DIR [--palpa target/release/palpa] [--work DIR]
+The GP learns the principal stress by default (`--gp-target principal`, the GP this study was
+run with, see the README); `--gp-target tensor` blends the stress-tensor GP instead.
+
+    python surrogate/scripts/cv_ensemble.py CAMPAIGN_DIR [--palpa target/release/palpa] [--work DIR] [--gp-target T]
     (needs numpy; about 12 s of MLP training per fold on 2 cores)
 """
 import argparse
@@ -37,6 +40,8 @@ def main(argv):
     ap.add_argument("campaign")
     ap.add_argument("--palpa", default="target/release/palpa")
     ap.add_argument("--work", default=None, help="where the fold datasets and models go (default: a temporary directory)")
+    ap.add_argument("--gp-target", default="principal", choices=("principal", "tensor"),
+                    help="what the GP learns (palpa train --target), principal by default")
     a = ap.parse_args(argv)
     try:
         d = Data(a.campaign)
@@ -60,7 +65,7 @@ def main(argv):
         np.savez(os.path.join(fold, "dataset.npz"), **{**z, "split": split})
         shutil.copy(f"{a.campaign}/manifest.json", fold)
         rows = d.loc == l
-        for model, extra in (("gp", []), ("mlp", ["--optimizer", "adam"])):
+        for model, extra in (("gp", ["--target", a.gp_target]), ("mlp", ["--optimizer", "adam"])):
             r = subprocess.run([a.palpa, "train", fold, "--model", model, "--out", os.path.join(fold, model)] + extra,
                                capture_output=True, text=True)
             if r.returncode:

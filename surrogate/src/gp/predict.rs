@@ -85,7 +85,7 @@ impl GpPredictor {
         }
     }
 
-    /// Number of outputs R.
+    /// Number of raw outputs M (R, or 6R on the tensor target).
     pub fn n_outputs(&self) -> usize {
         self.out.len()
     }
