@@ -20,8 +20,8 @@
 //! **Accuracy.** The polynomial adds at most `4e-12 p`. The rounding of `r` itself
 //! (about `1e-15`) is amplified near `r = -1`, where the two largest eigenvalues meet and
 //! `dc/dr` grows like `1 / sqrt(1 + r)`: there the error is about `p sqrt(1e-15)`, i.e. `1e-7`
-//! of the deviatoric stress. The tests check `1e-6 p + 1e-12 |S|` against nalgebra; for a
-//! surrogate whose error is a few percent this is round-off.
+//! of the deviatoric stress. The tests allow `1e-6 |B| + 1e-12 |S|` (Frobenius norms) against
+//! nalgebra; for a surrogate whose error is a few percent this is round-off.
 
 /// Degree-12 monomial coefficients of `c(h) = cos(2/3 acos h)` on `[0, 1]` (lowest first).
 const C_OF_H: [f64; 13] = [
