@@ -10,7 +10,8 @@
 //! - `--stdin`, for a live device loop: reads one JSON object per line,
 //!   `{"x": 0.04, "y": 0.05, "force": 20.0}` (an optional `"id"` of any JSON type is echoed back),
 //!   and writes one JSON line per input line, flushed at once:
-//!   `{"line": 1, "stress": [...], "variance": null}` (`variance` [Pa^2] for a GP). A line that
+//!   `{"line": 1, "stress": [...], "variance": null}` (`variance` [Pa^2] for a GP: the latent
+//!   variance shared by its raw outputs, on the tensor target by every stress component). A line that
 //!   cannot be used gets `{"line": N, "error": "..."}` and the stream goes on; blank lines are
 //!   skipped. A closed stdout (the reader has gone) ends the stream quietly. The model is
 //!   loaded once ([`surrogate::Predictor`], the hand-written forward pass).
@@ -44,8 +45,8 @@ pub struct PredictArgs {
     pub png: Option<PathBuf>,
     /// Stream instead: read JSON lines {"x": m, "y": m, "force": N, "id": optional} from stdin,
     /// write one JSON line per input, {"line": n, "id": .., "stress": [Pa, ...], "variance":
-    /// Pa^2 or null}, flushed at once; a bad line gets {"line": n, "error": ".."} and the stream
-    /// goes on.
+    /// Pa^2 or null (a GP's latent variance; on the tensor target, of each stress component)},
+    /// flushed at once; a bad line gets {"line": n, "error": ".."} and the stream goes on.
     #[arg(long, conflicts_with_all = ["x", "y", "force", "png"])]
     pub stdin: bool,
 }

@@ -93,6 +93,11 @@ pub struct TrainArgs {
     /// [default: 3].
     #[arg(long)]
     pub restarts: Option<usize>,
+    /// GP: the largest fraction of the normalised training targets' energy that the mean's
+    /// output basis may drop (the accuracy-versus-latency knob of the GP's serving cost)
+    /// [default: 1e-4]; 0 keeps every output direction, the exact posterior mean.
+    #[arg(long)]
+    pub output_tolerance: Option<f64>,
     /// Worker threads of the global pool [default: all cores]. The trainers themselves run on
     /// one thread, so that a seed gives the same model on any machine.
     #[arg(long)]
@@ -149,6 +154,14 @@ fn options(a: &TrainArgs) -> Result<TrainOptions, String> {
     }
     if let Some(r) = a.restarts {
         opts.gp.restarts = r;
+    }
+    if let Some(t) = a.output_tolerance {
+        if !(0.0..1.0).contains(&t) {
+            return Err(format!(
+                "--output-tolerance {t}: give a fraction in [0, 1), e.g. 1e-4 (0 = exact mean)"
+            ));
+        }
+        opts.gp.output_tolerance = t;
     }
     opts.target = a.target.map(Target::from);
     Ok(opts)

@@ -42,8 +42,10 @@ fn main() -> surrogate::Result<()> {
         println!("{gp}\n");
         if let Ok(png) = std::env::var("MAP") {
             // the GP's prediction at test location A, full force
+            // raw outputs (6R stress components on the tensor target) to the R principal stresses
             let mut p = gp_model.to_predictor();
-            let values = p.predict_inputs(&[0.037, 0.062, 37.0]).to_vec();
+            let mut map = surrogate::target::TargetMap::new(gp.target, data.n_roi());
+            let values = map.apply(p.predict_inputs(&[0.037, 0.062, 37.0])).to_vec();
             surrogate::render_map(
                 data.roi_centroids.view(),
                 &values,

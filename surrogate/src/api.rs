@@ -31,7 +31,9 @@ pub struct TrainOptions {
 pub struct Prediction {
     /// ROI maximum principal stress [Pa], one per ROI element.
     pub stress: Vec<f64>,
-    /// GP predictive variance [Pa^2] (shared by all ROI elements); `None` for an MLP.
+    /// GP predictive (latent) variance [Pa^2], shared by all raw outputs: by all ROI elements on
+    /// the principal target, by every stress component of every element on the tensor target
+    /// (not the variance of the served principal stress); `None` for an MLP.
     pub variance: Option<f64>,
 }
 

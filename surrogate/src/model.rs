@@ -136,7 +136,9 @@ impl TrainedModel {
         }
     }
 
-    /// A serving predictor over this model (same arithmetic as after save and load).
+    /// A serving predictor over this model (same arithmetic as after save and load). Its outputs
+    /// are the raw ones (6R stress components on the tensor target); map them with
+    /// `target::TargetMap` as [`Predictor`] does.
     pub fn to_predictor(&self) -> PredictorImpl {
         match self {
             TrainedModel::Mlp(m) => {
@@ -401,6 +403,15 @@ impl Predictor {
                 let (coef, basis) = if meta.version < 2 {
                     (take_f64(&mut set, &st, "alpha", &[n, m])?, Vec::new())
                 } else if let Some(rank) = set.get("basis").and_then(|t| t.shape.first().copied()) {
+                    if rank == 0 || rank > n.min(m) {
+                        return Err(Error::format(
+                            &st,
+                            format!(
+                                "basis has {rank} rows, expected 1 to {} (n = {n}, M = {m})",
+                                n.min(m)
+                            ),
+                        ));
+                    }
                     let b = take_f64(&mut set, &st, "basis", &[rank, m])?;
                     (take_f64(&mut set, &st, "coef", &[n, rank])?, b)
                 } else {

@@ -15,7 +15,9 @@
 //! analytic in `h` on `[0, 1]` (the square-root singularities of `acos` at `r = +-1` cancel), so
 //! a degree-12 polynomial in `h` (Chebyshev interpolant, largest error 1.9e-12, Horner form)
 //! replaces both library calls. No branch depends on the data except the isotropic guard, so
-//! the loop over elements vectorises.
+//! the loop over elements could vectorise (it does not yet: the components are interleaved).
+//! The deviator is divided by its largest entry first, so any finite tensor, in any units,
+//! gives a finite result.
 //!
 //! **Accuracy.** The polynomial adds at most `4e-12 p`. The rounding of `r` itself
 //! (about `1e-15`) is amplified near `r = -1`, where the two largest eigenvalues meet and
@@ -45,8 +47,19 @@ const C_OF_H: [f64; 13] = [
 #[inline(always)]
 pub fn max_principal(s: &[f64]) -> f64 {
     let m = (s[0] + s[1] + s[2]) * (1.0 / 3.0);
+    // the deviator divided by its largest entry q, so that p^3 neither underflows nor
+    // overflows whatever the units; q = 0 is the isotropic tensor
     let (a, b, c) = (s[0] - m, s[1] - m, s[2] - m);
-    let (xy, yz, zx) = (s[3], s[4], s[5]);
+    let q = a
+        .abs()
+        .max(b.abs())
+        .max(c.abs())
+        .max(s[3].abs())
+        .max(s[4].abs())
+        .max(s[5].abs());
+    let iq = if q > 0.0 { 1.0 / q } else { 0.0 };
+    let (a, b, c) = (a * iq, b * iq, c * iq);
+    let (xy, yz, zx) = (s[3] * iq, s[4] * iq, s[5] * iq);
     // p^2 = J2 / 3
     let p2 = (0.5 * (a * a + b * b + c * c) + xy * xy + yz * yz + zx * zx) * (1.0 / 3.0);
     let det = a * (b * c - yz * yz) - xy * (xy * c - yz * zx) + zx * (xy * yz - b * zx);
@@ -62,16 +75,17 @@ pub fn max_principal(s: &[f64]) -> f64 {
     for k in (0..12).rev() {
         cth = cth * h + C_OF_H[k];
     }
-    m + 2.0 * p * cth
+    m + 2.0 * q * p * cth
 }
 
 /// `out[e] = max_principal(raw[6 e .. 6 e + 6])` for every element `e`. On x86-64 the loop is
-/// also compiled with AVX2 and FMA and picked at run time, like `kernels::accumulate_rows`.
+/// also compiled with AVX2 and picked at run time, like `kernels::accumulate_rows` (the same
+/// arithmetic: Rust does not fuse multiply-adds on its own).
 pub fn max_principal_rows(raw: &[f64], out: &mut [f64]) {
     #[cfg(target_arch = "x86_64")]
     {
-        if std::is_x86_feature_detected!("avx2") && std::is_x86_feature_detected!("fma") {
-            // SAFETY: the processor supports AVX2 and FMA, checked just above.
+        if std::is_x86_feature_detected!("avx2") {
+            // SAFETY: the processor supports AVX2, checked just above.
             unsafe { max_principal_rows_avx2(raw, out) };
             return;
         }
@@ -80,7 +94,7 @@ pub fn max_principal_rows(raw: &[f64], out: &mut [f64]) {
 }
 
 #[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2,fma")]
+#[target_feature(enable = "avx2")]
 unsafe fn max_principal_rows_avx2(raw: &[f64], out: &mut [f64]) {
     max_principal_rows_plain(raw, out)
 }
@@ -151,6 +165,16 @@ mod tests {
         check([1.0, 1.0 + 1e-9, -3.0, 1e-10, 0.0, 0.0]);
         check([1e4, 1e4, 1e4, 1e-3, 2e-3, -1e-3]);
         assert_eq!(max_principal(&[2.0, 2.0, 2.0, 0.0, 0.0, 0.0]), 2.0);
+        // tiny and huge magnitudes: finite and scale with the tensor
+        for scale in [1e-200, 1e-120, 1e120, 1e200] {
+            let s = [3.0, -1.0, 0.5, 2.0, -0.25, 1.0].map(|v| v * scale);
+            let want = reference(&[3.0, -1.0, 0.5, 2.0, -0.25, 1.0]) * scale;
+            let got = max_principal(&s);
+            assert!(
+                (got - want).abs() <= 1e-12 * want.abs(),
+                "{scale}: {got} against {want}"
+            );
+        }
         assert!(max_principal(&[f64::NAN, 0.0, 0.0, 0.0, 0.0, 0.0]).is_nan());
     }
 }

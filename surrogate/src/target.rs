@@ -69,14 +69,6 @@ impl Target {
         }
     }
 
-    /// ROI elements served by a model of `n_outputs` outputs, or `None` if they do not divide.
-    pub fn n_roi(self, n_outputs: usize) -> Option<usize> {
-        match self {
-            Target::Principal => Some(n_outputs),
-            Target::Tensor => (n_outputs % 6 == 0).then_some(n_outputs / 6),
-        }
-    }
-
     /// The target a `kind` model trains on when none is asked for: the tensor for a GP when the
     /// dataset holds `S` (module doc), the principal stress otherwise (the paper's MLP).
     pub fn default_for(kind: crate::model::ModelKind, data: &Dataset) -> Target {

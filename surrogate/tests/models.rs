@@ -99,7 +99,13 @@ fn mlp_minibatch_adam_trains() {
 #[test]
 fn gp_fits_held_out_locations_with_sensible_variance() {
     let d = make_synthetic_dataset(R);
-    let (model, report) = train_model(&d, ModelKind::Gp, &gp_options()).unwrap();
+    // on Y here; the tensor target has its own test below
+    let opts = TrainOptions {
+        target: Some(Target::Principal),
+        ..gp_options()
+    };
+    let (model, report) = train_model(&d, ModelKind::Gp, &opts).unwrap();
+    assert_eq!(report.target, Target::Principal);
     assert!(report.test_fit.unwrap() > FLOOR, "{report}");
     let TrainedModel::Gp(g) = &model else {
         unreachable!()
@@ -135,6 +141,10 @@ fn assert_round_trip(kind: ModelKind, opts: &TrainOptions) {
     let dir = tempfile::tempdir().unwrap();
     let d = make_synthetic_dataset(R);
     let (model, report) = train_model(&d, kind, opts).unwrap();
+    if let TrainedModel::Gp(g) = &model {
+        // the synthetic targets are smooth: the output basis is in use, and saved with the model
+        assert!(g.basis.is_some(), "{report}");
+    }
     let path = dir.path().join("model.safetensors");
     model
         .save(
@@ -206,6 +216,93 @@ fn tensor_gp_save_load_round_trip_predicts_identically() {
     o.gp.restarts = 0;
     o.gp.max_iterations = 20;
     assert_round_trip(ModelKind::Gp, &o);
+}
+
+#[test]
+fn version_1_gp_files_load_and_a_bad_output_basis_is_an_error() {
+    use surrogate::tensor_file::{read_tensors, write_tensors};
+    let dir = tempfile::tempdir().unwrap();
+    let d = make_synthetic_dataset(R);
+    let opts = TrainOptions {
+        target: Some(Target::Principal),
+        gp: GpOptions {
+            restarts: 0,
+            max_iterations: 20,
+            ..Default::default()
+        },
+        ..Default::default()
+    };
+    let (model, report) = train_model(&d, ModelKind::Gp, &opts).unwrap();
+    let path = dir.path().join("m.safetensors");
+    let save = |m: &TrainedModel| {
+        m.save(
+            &path,
+            d.roi_ids.as_slice().unwrap(),
+            d.roi_centroids.view(),
+            &report,
+        )
+        .unwrap()
+    };
+    let x = [d.x[(40, 0)], d.x[(40, 1)], d.x[(40, 2)]];
+    // a version-1 file: the full coefficients named `alpha`, no basis, no target field
+    let TrainedModel::Gp(g) = &model else {
+        unreachable!()
+    };
+    let mut exact = g.clone();
+    exact.coef = exact.coef.dot(exact.basis.as_ref().unwrap());
+    exact.basis = None;
+    let exact = TrainedModel::Gp(exact);
+    save(&exact);
+    let want = Predictor::load(&path)
+        .unwrap()
+        .predict(x[0], x[1], x[2])
+        .to_vec();
+    let mut set = read_tensors(&path).unwrap();
+    let coef = set.remove("coef").unwrap();
+    set.insert("alpha".into(), coef);
+    write_tensors(&path, &set).unwrap();
+    let json = path.with_extension("json");
+    let text = std::fs::read_to_string(&json).unwrap();
+    let mut meta: serde_json::Value = serde_json::from_str(&text).unwrap();
+    meta["version"] = 1.into();
+    meta.as_object_mut().unwrap().remove("target");
+    std::fs::write(&json, serde_json::to_string(&meta).unwrap()).unwrap();
+    let mut v1 = Predictor::load(&path).unwrap();
+    assert_eq!(v1.predict(x[0], x[1], x[2]), &want[..]);
+    // the basis model predicts the projection of that mean: close, not equal
+    save(&model);
+    let got = Predictor::load(&path)
+        .unwrap()
+        .predict(x[0], x[1], x[2])
+        .to_vec();
+    let scale = want.iter().fold(0.0f64, |m, v| m.max(v.abs()));
+    for (a, b) in got.iter().zip(&want) {
+        assert!((a - b).abs() <= 1e-2 * scale, "{a} against {b}");
+    }
+    // an empty basis would silently serve the mean field: it is an error naming the file
+    let mut set = read_tensors(&path).unwrap();
+    let m = set["basis"].shape[1];
+    let n = set["coef"].shape[0];
+    set.insert(
+        "basis".into(),
+        surrogate::tensor_file::Tensor {
+            shape: vec![0, m],
+            data: surrogate::tensor_file::TensorData::F64(Vec::new()),
+        },
+    );
+    set.insert(
+        "coef".into(),
+        surrogate::tensor_file::Tensor {
+            shape: vec![n, 0],
+            data: surrogate::tensor_file::TensorData::F64(Vec::new()),
+        },
+    );
+    write_tensors(&path, &set).unwrap();
+    let err = Predictor::load(&path).unwrap_err().to_string();
+    assert!(
+        err.contains("m.safetensors") && err.contains("basis"),
+        "{err}"
+    );
 }
 
 #[test]

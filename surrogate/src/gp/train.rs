@@ -16,7 +16,7 @@
 //!
 //! **Output basis.** The predictive mean of all M outputs, `mu + s A^T k*` with `A = K^-1 V`
 //! (n x M), costs n M multiply-adds. With the thin singular value decomposition of the
-//! normalised targets, `V = U Sigma W^T`, every column of `A` lies in the row space of `V`, so
+//! normalised targets, `V = U Sigma W^T`, every row of `A` lies in the row space of `V`, so
 //! `A = (A W) W^T` exactly, and keeping only the leading r right singular vectors `W_r` gives
 //! `A ~ (A W_r) W_r^T`: the mean becomes `mu + s W_r ((A W_r)^T k*)`, r (n + M) multiply-adds,
 //! the projection of the exact mean on the training targets' leading r output directions (the
