@@ -105,12 +105,12 @@ pub fn predict_one(
         "{} model {} on the {} target ({}): {} ROI elements\nfinger at x = {x} m, y = {y} m, force = {force} N\n",
         meta.kind,
         model.display(),
-        meta.target,
+        meta.report.target,
         meta.report.size,
         stress.len()
     );
     if let Some(v) = variance {
-        let of = match meta.target {
+        let of = match meta.report.target {
             surrogate::Target::Principal => "all ROI elements",
             surrogate::Target::Tensor => "every stress component of every ROI element",
         };

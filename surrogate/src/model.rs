@@ -13,7 +13,8 @@
 //! - Both: `roi_centroids` `[R, 3]` f64 [m], for rendering maps from the model alone.
 //!
 //! M is the number of raw outputs: R for the principal-stress target, 6R for the tensor target
-//! (`target`); [`Predictor`] always serves the R maximum principal stresses.
+//! (`target`, recorded as the training report's `target`); [`Predictor`] always serves the R
+//! maximum principal stresses.
 
 use crate::dataset::write_atomic;
 use crate::error::{Error, Result};
@@ -21,7 +22,7 @@ use crate::gp::{GpModel, GpPredictor, SeArd};
 use crate::mlp::{DenseLayer, MlpModel, MlpPredictor};
 use crate::normalise::Scaling;
 use crate::report::TrainReport;
-use crate::target::{Target, TargetMap};
+use crate::target::TargetMap;
 use crate::tensor_file::{
     read_tensors, take_f32, take_f64, write_tensors, Tensor, TensorData, TensorSet,
 };
@@ -77,9 +78,6 @@ pub struct ModelMeta {
     pub version: u32,
     /// Model family.
     pub kind: ModelKind,
-    /// What the raw outputs stand for; absent (version 1) means the principal stress.
-    #[serde(default)]
-    pub target: Target,
     /// Names of the inputs, in order (`x`, `y`, `force`); units m, m, N.
     pub input_columns: Vec<String>,
     /// ROI element ids, in order; the served outputs are their maximum principal stress [Pa].
@@ -269,7 +267,6 @@ impl TrainedModel {
             format: MODEL_FORMAT.into(),
             version: MODEL_VERSION,
             kind: self.kind(),
-            target: report.target,
             input_columns: vec!["x".into(), "y".into(), "force".into()],
             roi_ids: roi_ids.to_vec(),
             input_scaling,
@@ -333,7 +330,10 @@ impl Predictor {
             ));
         }
         let r = meta.roi_ids.len();
-        let m = meta.target.n_outputs(r);
+        // what the raw outputs stand for: the training report's target (version-1 files have
+        // none, and learned the principal stress)
+        let target = meta.report.target;
+        let m = target.n_outputs(r);
         let d = meta.input_columns.len();
         if meta.input_scaling.len() != d || meta.output_scaling.len() != m {
             return Err(Error::format(
@@ -343,7 +343,7 @@ impl Predictor {
                      ({m} outputs on the {} target)",
                     meta.input_scaling.len(),
                     meta.output_scaling.len(),
-                    meta.target
+                    target
                 ),
             ));
         }
@@ -429,7 +429,7 @@ impl Predictor {
                 ))
             }
         };
-        let map = TargetMap::new(meta.target, r);
+        let map = TargetMap::new(target, r);
         Ok(Predictor {
             meta,
             roi_centroids,

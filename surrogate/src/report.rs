@@ -25,6 +25,7 @@ pub struct TrainReport {
     /// Model family.
     pub kind: ModelKind,
     /// What the outputs stand for (`target`); models saved before it existed learned `Y`.
+    /// A saved model's target is this one.
     #[serde(default)]
     pub target: Target,
     /// Architecture in words, e.g. `3-64-126-256-512-377` or `SE-ARD, n=150`.

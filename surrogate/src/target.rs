@@ -19,6 +19,7 @@
 
 use crate::dataset::Dataset;
 use crate::error::{Error, Result};
+use crate::model::ModelKind;
 use crate::principal::max_principal_rows;
 use ndarray::Array2;
 use serde::{Deserialize, Serialize};
@@ -71,9 +72,9 @@ impl Target {
 
     /// The target a `kind` model trains on when none is asked for: the tensor for a GP when the
     /// dataset holds `S` (module doc), the principal stress otherwise (the paper's MLP).
-    pub fn default_for(kind: crate::model::ModelKind, data: &Dataset) -> Target {
+    pub fn default_for(kind: ModelKind, data: &Dataset) -> Target {
         match kind {
-            crate::model::ModelKind::Gp if data.stress.is_some() => Target::Tensor,
+            ModelKind::Gp if data.stress.is_some() => Target::Tensor,
             _ => Target::Principal,
         }
     }

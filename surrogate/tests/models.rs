@@ -265,7 +265,7 @@ fn version_1_gp_files_load_and_a_bad_output_basis_is_an_error() {
     let text = std::fs::read_to_string(&json).unwrap();
     let mut meta: serde_json::Value = serde_json::from_str(&text).unwrap();
     meta["version"] = 1.into();
-    meta.as_object_mut().unwrap().remove("target");
+    meta["report"].as_object_mut().unwrap().remove("target");
     std::fs::write(&json, serde_json::to_string(&meta).unwrap()).unwrap();
     let mut v1 = Predictor::load(&path).unwrap();
     assert_eq!(v1.predict(x[0], x[1], x[2]), &want[..]);

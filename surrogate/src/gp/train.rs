@@ -195,15 +195,10 @@ fn compute_output_basis(v: &DMatrix<f64>, tolerance: f64) -> Option<(DMatrix<f64
     if !(tolerance > 0.0) || n == 0 || m == 0 {
         return None;
     }
+    // `svd` sorts the singular values in descending order (nalgebra's guarantee)
     let svd = v.clone().svd(false, true);
     let w_t = svd.v_t?;
-    // singular values in descending order (nalgebra does not promise an order)
-    let mut order: Vec<usize> = (0..svd.singular_values.len()).collect();
-    order.sort_by(|&a, &b| svd.singular_values[b].total_cmp(&svd.singular_values[a]));
-    let energy: Vec<f64> = order
-        .iter()
-        .map(|&i| svd.singular_values[i].powi(2))
-        .collect();
+    let energy: Vec<f64> = svd.singular_values.iter().map(|s| s * s).collect();
     let total: f64 = energy.iter().sum();
     if !(total > 0.0) {
         return None;
@@ -220,8 +215,10 @@ fn compute_output_basis(v: &DMatrix<f64>, tolerance: f64) -> Option<(DMatrix<f64
     if r * (n + m) >= n * m {
         return None;
     }
-    let rows = DMatrix::from_fn(r, m, |i, j| w_t[(order[i], j)]);
-    Some((rows, ((total - kept) / total).max(0.0)))
+    Some((
+        w_t.rows(0, r).into_owned(),
+        ((total - kept) / total).max(0.0),
+    ))
 }
 
 /// Indices of the rows of `v` that differ from every earlier row (exact comparison).
