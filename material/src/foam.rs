@@ -60,8 +60,10 @@
 //! stiffness-proportional damping causes. Paper flesh: `K = 2 GPa`, `G = 40 kPa`, rho = 1060:
 //! `c = 1374 m/s`.
 
-use crate::law::{checked_jacobian, Law, LawError, Mat3, Response};
-use crate::principal::{all_finite6, ddot6, mat_from_sym6, Principal, Sym6};
+use crate::law::{faults, full, Law, LawOut};
+use crate::principal::{all_finite6, ddot6, Principal, Sym6};
+use crate::real::{Mask, Real};
+use crate::tensor::{det, M3};
 
 /// A uniaxial nominal stress-stretch curve.
 #[derive(Clone, Debug, PartialEq)]
@@ -248,22 +250,38 @@ impl Foam {
     /// `f(x)` and `df/dx` at `x = ln lb` (Pa).
     #[inline(always)]
     pub fn f_and_slope(&self, x: f64) -> (f64, f64) {
+        self.f_and_slope_r(x)
+    }
+
+    /// [`Foam::f_and_slope`] in every lane: the interval's cubic is fetched per lane (a gather),
+    /// the rest is lane-wise, and lanes beyond the table take its linear extrapolation.
+    #[inline(always)]
+    pub fn f_and_slope_r<R: Real>(&self, x: R) -> (R, R) {
         let t = (x - X_MIN) * self.inv_h;
-        let n = N_GRID - 1;
-        if t <= 0.0 {
-            let [f0, d0] = self.ends[0];
-            return (f0 + d0 * t, d0 * self.inv_h);
+        let n = (N_GRID - 1) as f64;
+        let below = t.le(R::zero());
+        let above = t.ge(R::splat(n));
+        // The gather: plain arrays per coefficient, loaded as whole lane vectors afterwards.
+        let mut tl = [0.0; crate::real::LANES];
+        t.write_to(&mut tl);
+        let mut cl = [[0.0; crate::real::LANES]; 5];
+        for l in 0..R::LANES {
+            // Truncation inside the table; clamped (NaN to 0) so that every lane reads a cubic.
+            let k = (tl[l].clamp(0.0, n - 1.0) as u32 as usize).min(N_GRID - 2);
+            let q = &self.cubic[k];
+            cl[0][l] = q[0];
+            cl[1][l] = q[1];
+            cl[2][l] = q[2];
+            cl[3][l] = q[3];
+            cl[4][l] = k as f64;
         }
-        if t >= n as f64 {
-            let [f1, d1] = self.ends[1];
-            return (f1 + d1 * (t - n as f64), d1 * self.inv_h);
-        }
-        // 0 < t < n here: the u32 conversion is exact truncation.
-        let k = t as u32 as usize;
-        let s = t - k as f64;
-        let [c0, c1, c2, c3] = self.cubic[k];
+        let [c0, c1, c2, c3, kf] = crate::arr![5, |i| R::from_slice(&cl[i])];
+        let s = t - kf;
         let f = c0 + s * (c1 + s * (c2 + s * c3));
-        let df = c1 + s * (2.0 * c2 + 3.0 * s * c3);
+        let df = c1 + s * (c2 * 2.0 + s * 3.0 * c3);
+        let [[f0, d0], [f1, d1]] = self.ends;
+        let f = R::select(below, t * d0 + f0, R::select(above, (t - n) * d1 + f1, f));
+        let df = R::select(below, R::splat(d0), R::select(above, R::splat(d1), df));
         (f, df * self.inv_h)
     }
 
@@ -321,63 +339,69 @@ impl Law for Foam {
     }
     fn initial_wave_speed(&self) -> f64 {
         let m = self.bulk + 2.0 / 3.0 * self.f_and_slope(0.0).1;
-        damped_wave_speed(m, self.damping * self.shear, self.rho)
+        damped_wave_speed::<f64>(m, self.damping * self.shear, self.rho)
     }
 
     fn initial_shear_modulus(&self) -> f64 {
         self.f_and_slope(0.0).1 / 2.0
     }
 
-    #[inline]
-    fn evaluate(&self, f: &Mat3, _dt: f64, history: &mut [f64]) -> Result<Response, LawError> {
-        checked_jacobian(f)?;
-        let p = Principal::of(f)?;
+    fn name(&self) -> &'static str {
+        "simplified_rubber"
+    }
+
+    #[inline(always)]
+    fn stress<R: Real>(&self, f: &M3<R>, _dt: f64, history: &mut [R]) -> LawOut<R> {
+        let j = det(f);
+        let (p, collapsed) = Principal::of(f);
         let lb = p.ln_isochoric();
-        let (f0, d0) = self.f_and_slope(lb[0]);
-        let (f1, d1) = self.f_and_slope(lb[1]);
-        let (f2, d2) = self.f_and_slope(lb[2]);
+        let (f0, d0) = self.f_and_slope_r(lb[0]);
+        let (f1, d1) = self.f_and_slope_r(lb[1]);
+        let (f2, d2) = self.f_and_slope_r(lb[2]);
         let mean = (f0 + f1 + f2) * (1.0 / 3.0);
         let dev = [f0 - mean, f1 - mean, f2 - mean];
-        let pk = self.bulk * p.ln_j;
+        let pk = p.ln_j * self.bulk;
         let mut pk2 = p.pk2_from_kirchhoff(&[dev[0] + pk, dev[1] + pk, dev[2] + pk]);
         let tmax = dev[0].abs().max(dev[1].abs()).max(dev[2].abs());
-        let m =
-            self.bulk * (1.0 - 2.0 * p.ln_j).max(1.0) + 2.0 / 3.0 * d0.max(d1).max(d2) + 2.0 * tmax;
-        let mut dissipation = 0.0;
+        let m = (R::splat(1.0) - p.ln_j * 2.0).max(R::splat(1.0)) * self.bulk
+            + d0.max(d1).max(d2) * (2.0 / 3.0)
+            + tmax * 2.0;
+        let mut dissipation = R::zero();
         if self.damping > 0.0 {
             let c1 = &p.c_minus_i;
-            let prev: &mut [f64] = &mut history[..6];
-            let mut de: Sym6 = [0.0; 6];
+            let prev: &mut [R] = &mut history[..6];
+            let mut de: Sym6<R> = [R::zero(); 6];
             for k in 0..6 {
-                let e = 0.5 * c1[k];
+                let e = c1[k] * 0.5;
                 de[k] = e - prev[k];
                 prev[k] = e;
             }
             let tr = (de[0] + de[1] + de[2]) * (1.0 / 3.0);
             let c = 2.0 * self.damping * self.shear;
-            let sv: Sym6 = [
-                c * (de[0] - tr),
-                c * (de[1] - tr),
-                c * (de[2] - tr),
-                c * de[3],
-                c * de[4],
-                c * de[5],
+            let sv: Sym6<R> = [
+                (de[0] - tr) * c,
+                (de[1] - tr) * c,
+                (de[2] - tr) * c,
+                de[3] * c,
+                de[4] * c,
+                de[5] * c,
             ];
             dissipation = ddot6(&sv, &de);
             for k in 0..6 {
                 pk2[k] += sv[k];
             }
         }
-        let wave_speed = damped_wave_speed(m, self.damping * self.shear, self.rho);
-        if !(wave_speed.is_finite() && all_finite6(&pk2)) {
-            return Err(LawError::NotFinite("simplified_rubber"));
-        }
-        Ok(Response {
-            pk2: mat_from_sym6(&pk2),
+        let wave_speed = damped_wave_speed(m, R::splat(self.damping * self.shear), self.rho);
+        let finite = wave_speed.is_finite() & all_finite6(&pk2);
+        let (fault, fault_value) = faults(j, collapsed, finite);
+        LawOut {
+            pk2: full(&pk2),
             wave_speed,
             dissipation,
-            failed: false,
-        })
+            failed: R::Mask::splat(false),
+            fault,
+            fault_value,
+        }
     }
 }
 
@@ -387,13 +411,15 @@ impl Law for Foam {
 /// it equals `(sqrt(M^2 + D^2) + D) / sqrt(M rho)`: no cancellation, and the two square roots
 /// run side by side.
 #[inline(always)]
-fn damped_wave_speed(m: f64, d: f64, rho: f64) -> f64 {
+fn damped_wave_speed<R: Real>(m: R, d: R, rho: f64) -> R {
     ((m * m + d * d).sqrt() + d) / (m * rho).sqrt()
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    #[allow(unused_imports)]
+    use crate::law::{LawError, Mat3};
     use nalgebra::Vector3;
 
     fn flesh() -> Foam {

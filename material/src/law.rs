@@ -11,7 +11,18 @@
 //! with `history_len() == 0` gets an empty slice and the solver allocates nothing for it.
 //! The slice holds the state at the start of the step on entry and must hold the state at the
 //! end of the step on return.
+//!
+//! Every law is written once, generic over the number type ([`Law::stress`] over a
+//! [`Real`]): `f64` evaluates one point ([`Law::evaluate`], the material-point driver and the
+//! tests), [`crate::real::F64x8`] evaluates eight points of a batch at once (the solver's element
+//! loop), with the history of the batch in struct-of-arrays form (value `k` of the eight points
+//! is `history[k]`). Where a lane cannot be evaluated (inverted, non-finite), the law sets its
+//! fault code ([`LawOut::fault`]) instead of returning early; [`fault_error`] turns a code into
+//! the [`LawError`] the scalar path reports.
 
+use crate::principal::Sym6;
+use crate::real::Real;
+use crate::tensor::{from_mat3, to_mat3, M3};
 use nalgebra::Matrix3;
 use thiserror::Error;
 
@@ -29,6 +40,59 @@ pub struct Response {
     pub dissipation: f64,
     /// The point has reached its failure criterion and its element should be eroded.
     pub failed: bool,
+}
+
+/// What a law returns for one point or one batch of points ([`Law::stress`]).
+#[derive(Clone, Copy, Debug)]
+pub struct LawOut<R: Real> {
+    /// Second Piola-Kirchhoff stress S (Pa).
+    pub pk2: M3<R>,
+    /// Current dilatational wave speed (m/s).
+    pub wave_speed: R,
+    /// Energy dissipated during this step (J/m^3 of reference volume).
+    pub dissipation: R,
+    /// The point reached its failure criterion.
+    pub failed: R::Mask,
+    /// 0 where the point was evaluated, else one of the `FAULT_*` codes.
+    pub fault: R,
+    /// The quantity the fault names (det F for [`FAULT_JACOBIAN`]).
+    pub fault_value: R,
+}
+
+/// Fault code: det F <= 0 (or not finite).
+pub const FAULT_JACOBIAN: f64 = 1.0;
+/// Fault code: a principal stretch collapsed to zero.
+pub const FAULT_COLLAPSED: f64 = 2.0;
+/// Fault code: the stress or the wave speed is not finite.
+pub const FAULT_NOT_FINITE: f64 = 3.0;
+
+/// Fault codes of a law evaluation in order of precedence: the Jacobian first (as a scalar
+/// check would stop there), then a collapsed stretch, then a non-finite result. Returns
+/// `(fault, fault_value)`.
+#[inline(always)]
+pub fn faults<R: Real>(j: R, collapsed: R::Mask, finite: R::Mask) -> (R, R) {
+    let mut code = R::select(finite, R::zero(), R::splat(FAULT_NOT_FINITE));
+    code = R::select(collapsed, R::splat(FAULT_COLLAPSED), code);
+    let jac_bad = !(j.gt(R::zero()) & j.is_finite());
+    code = R::select(jac_bad, R::splat(FAULT_JACOBIAN), code);
+    (code, j)
+}
+
+/// The error a fault code stands for; `what` names the law in a non-finite result.
+pub fn fault_error(code: f64, value: f64, what: &'static str) -> LawError {
+    if code == FAULT_JACOBIAN {
+        LawError::NonPositiveJacobian(value)
+    } else if code == FAULT_COLLAPSED {
+        LawError::NotFinite("principal stretch collapsed to zero")
+    } else {
+        LawError::NotFinite(what)
+    }
+}
+
+/// A symmetric stress given as Sym6, as a full matrix over `R`.
+#[inline(always)]
+pub fn full<R: Real>(s: &Sym6<R>) -> M3<R> {
+    [[s[0], s[3], s[5]], [s[3], s[1], s[4]], [s[5], s[4], s[2]]]
 }
 
 /// Why a law could not evaluate a state.
@@ -68,8 +132,25 @@ pub trait Law: Sync + Send {
     /// Instantaneous small-strain shear modulus of the undeformed material (Pa): the modulus
     /// that resists isochoric deformation, which shear-scaled hourglass control uses.
     fn initial_shear_modulus(&self) -> f64;
-    /// Evaluate the stress at deformation gradient `f` at the end of a step of length `dt` (s).
-    fn evaluate(&self, f: &Mat3, dt: f64, history: &mut [f64]) -> Result<Response, LawError>;
+    /// Short name of the law, for messages.
+    fn name(&self) -> &'static str;
+    /// Evaluate the stress at deformation gradient `f` (one point, or one per lane) at the end of
+    /// a step of length `dt` (s). `history` holds `history_len()` values of the point(s).
+    fn stress<R: Real>(&self, f: &M3<R>, dt: f64, history: &mut [R]) -> LawOut<R>;
+    /// [`Law::stress`] at one point, with the fault as an error.
+    #[inline]
+    fn evaluate(&self, f: &Mat3, dt: f64, history: &mut [f64]) -> Result<Response, LawError> {
+        let o = self.stress::<f64>(&from_mat3(f), dt, history);
+        if o.fault != 0.0 {
+            return Err(fault_error(o.fault, o.fault_value, self.name()));
+        }
+        Ok(Response {
+            pk2: to_mat3(&o.pk2),
+            wave_speed: o.wave_speed,
+            dissipation: o.dissipation,
+            failed: o.failed,
+        })
+    }
 }
 
 /// det F, refusing non-positive values.

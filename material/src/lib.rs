@@ -16,7 +16,9 @@ pub mod ogden;
 pub mod plasticity;
 pub mod principal;
 pub mod quantity;
+pub mod real;
 pub mod spec;
+pub mod tensor;
 
 pub use law::{Law, LawError, Mat3, Response};
 pub use library::named;

@@ -12,7 +12,10 @@
 //!
 //! Wave speed: c = sqrt((lambda + 2 mu) / rho).
 
-use crate::law::{checked_jacobian, Law, LawError, Mat3, Response};
+use crate::law::{faults, full, Law, LawOut};
+use crate::principal::c_minus_identity;
+use crate::real::{Mask, Real};
+use crate::tensor::{cofactor, det, mul, M3};
 
 /// Strain measure of the linear law.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -46,26 +49,55 @@ impl Law for LinearElastic {
     fn initial_shear_modulus(&self) -> f64 {
         self.mu
     }
-    #[inline]
-    fn evaluate(&self, f: &Mat3, _dt: f64, _h: &mut [f64]) -> Result<Response, LawError> {
-        checked_jacobian(f)?;
-        let i = Mat3::identity();
+    fn name(&self) -> &'static str {
+        "linear_elastic"
+    }
+    #[inline(always)]
+    fn stress<R: Real>(&self, f: &M3<R>, _dt: f64, _h: &mut [R]) -> LawOut<R> {
+        let j = det(f);
         let pk2 = match self.kinematics {
             Kinematics::Green => {
-                let e = (f.transpose() * f - i) * 0.5;
-                i * (self.lambda * e.trace()) + e * (2.0 * self.mu)
+                // E = (F^T F - I) / 2, S = lambda tr(E) I + 2 mu E.
+                let c1 = c_minus_identity(f);
+                let e: [R; 6] = crate::arr![6, |k| c1[k] * 0.5];
+                let tr = (e[0] + e[1] + e[2]) * self.lambda;
+                let mut s: [R; 6] = crate::arr![6, |k| e[k] * (2.0 * self.mu)];
+                for x in s.iter_mut().take(3) {
+                    *x += tr;
+                }
+                full(&s)
             }
             Kinematics::Small => {
-                let eps = (f + f.transpose()) * 0.5 - i;
-                let sigma = i * (self.lambda * eps.trace()) + eps * (2.0 * self.mu);
-                f.try_inverse().ok_or(LawError::NotFinite("singular F"))? * sigma
+                // sigma from eps = sym(F) - I, then S = F^-1 sigma so that P = F S = sigma.
+                let eps: [R; 6] = [
+                    f[0][0] - 1.0,
+                    f[1][1] - 1.0,
+                    f[2][2] - 1.0,
+                    (f[0][1] + f[1][0]) * 0.5,
+                    (f[1][2] + f[2][1]) * 0.5,
+                    (f[2][0] + f[0][2]) * 0.5,
+                ];
+                let tr = (eps[0] + eps[1] + eps[2]) * self.lambda;
+                let mut s: [R; 6] = crate::arr![6, |k| eps[k] * (2.0 * self.mu)];
+                for x in s.iter_mut().take(3) {
+                    *x += tr;
+                }
+                // F^-1 = cof(F)^T / J.
+                let cof = cofactor(f);
+                let ij = R::splat(1.0) / j;
+                let fi: M3<R> = crate::arr![3, |a| crate::arr![3, |b| cof[b][a] * ij]];
+                mul(&fi, &full(&s))
             }
         };
-        Ok(Response {
+        let finite = pk2[0][0].is_finite() & pk2[1][1].is_finite() & pk2[2][2].is_finite();
+        let (fault, fault_value) = faults(j, R::Mask::splat(false), finite);
+        LawOut {
             pk2,
-            wave_speed: self.initial_wave_speed(),
-            dissipation: 0.0,
-            failed: false,
-        })
+            wave_speed: R::splat(self.initial_wave_speed()),
+            dissipation: R::zero(),
+            failed: R::Mask::splat(false),
+            fault,
+            fault_value,
+        }
     }
 }

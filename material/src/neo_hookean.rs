@@ -9,7 +9,9 @@
 //!   c_d^2 = (lambda + 2 mu - 2 lambda ln J) / rho_0,
 //! which grows under compression (ln J < 0): the "stretch-stiffened" speed the time step needs.
 
-use crate::law::{checked_jacobian, Law, LawError, Mat3, Response};
+use crate::law::{faults, Law, LawOut};
+use crate::real::{Mask, Real};
+use crate::tensor::{cofactor, det, mul, scale, M3};
 
 /// Compressible neo-Hookean law.
 #[derive(Clone, Debug)]
@@ -32,26 +34,46 @@ impl Law for NeoHookean {
     fn initial_shear_modulus(&self) -> f64 {
         self.mu
     }
-    #[inline]
-    fn evaluate(&self, f: &Mat3, _dt: f64, _h: &mut [f64]) -> Result<Response, LawError> {
-        let j = checked_jacobian(f)?;
-        let c = f.transpose() * f;
-        let ci = c.try_inverse().ok_or(LawError::NotFinite("singular C"))?;
+    fn name(&self) -> &'static str {
+        "neo_hookean"
+    }
+    #[inline(always)]
+    fn stress<R: Real>(&self, f: &M3<R>, _dt: f64, _h: &mut [R]) -> LawOut<R> {
+        let j = det(f);
+        // C = F^T F and C^-1 = cof(C) / det C with det C = J^2 (C is symmetric).
+        let ft = [
+            [f[0][0], f[1][0], f[2][0]],
+            [f[0][1], f[1][1], f[2][1]],
+            [f[0][2], f[1][2], f[2][2]],
+        ];
+        let c = mul(&ft, f);
+        let ci = scale(&cofactor(&c), R::splat(1.0) / (j * j));
         let lnj = j.ln();
-        let pk2 = Mat3::identity() * self.mu + ci * (self.lambda * lnj - self.mu);
-        let m = (self.lambda + 2.0 * self.mu - 2.0 * self.lambda * lnj).max(self.mu);
-        Ok(Response {
+        let k = lnj * self.lambda - self.mu;
+        let mut pk2 = scale(&ci, k);
+        for i in 0..3 {
+            pk2[i][i] += R::splat(self.mu);
+        }
+        let m = (R::splat(self.lambda + 2.0 * self.mu) - lnj * (2.0 * self.lambda))
+            .max(R::splat(self.mu));
+        let wave_speed = (m / self.rho).sqrt();
+        let finite = wave_speed.is_finite() & pk2[0][0].is_finite() & pk2[1][1].is_finite();
+        let (fault, fault_value) = faults(j, R::Mask::splat(false), finite);
+        LawOut {
             pk2,
-            wave_speed: (m / self.rho).sqrt(),
-            dissipation: 0.0,
-            failed: false,
-        })
+            wave_speed,
+            dissipation: R::zero(),
+            failed: R::Mask::splat(false),
+            fault,
+            fault_value,
+        }
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::law::{LawError, Mat3};
     use nalgebra::Rotation3;
 
     fn law() -> NeoHookean {

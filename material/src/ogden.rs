@@ -83,8 +83,10 @@
 use std::cell::RefCell;
 use std::sync::atomic::{AtomicU64, Ordering};
 
-use crate::law::{checked_jacobian, Law, LawError, Mat3, Response};
-use crate::principal::{all_finite6, ddot6, mat_from_sym6, Principal, Sym6};
+use crate::law::{faults, full, Law, LawOut};
+use crate::principal::{all_finite6, ddot6, Principal, Sym6};
+use crate::real::{Mask, Real};
+use crate::tensor::{det, M3};
 
 /// Most Ogden terms a card may give.
 pub const MAX_TERMS: usize = 6;
@@ -308,50 +310,56 @@ impl Ogden {
         }
     }
 
-    /// Update the Prony history for the strain increment `de` over a step `dt`; returns the
-    /// summed viscous stresses `sum_i h_i` and the step's dissipation.
+    /// The Prony step factors of `dt`, from this thread's cache when it holds them.
     #[inline(always)]
-    fn prony_update(&self, dt: f64, de: &Sym6, hs: &mut [f64]) -> (Sym6, f64) {
+    fn prony_factors(&self, dt: f64) -> PronyFactors {
         PRONY_CACHE.with(|cache| {
             let key = (self.id, dt.to_bits());
             if cache.borrow().key != key {
                 *cache.borrow_mut() = self.compute_prony_factors(dt);
             }
-            let cache = cache.borrow();
-            let mut sv: Sym6 = [0.0; 6];
-            let mut dissipation = 0.0;
-            for (h, &[a, g, w]) in hs.chunks_exact_mut(6).zip(&cache.f[..self.np]) {
-                let old: Sym6 = [h[0], h[1], h[2], h[3], h[4], h[5]];
-                let mut new: Sym6 = [0.0; 6];
-                for k in 0..6 {
-                    new[k] = a * old[k] + g * de[k];
-                    sv[k] += new[k];
-                }
-                h.copy_from_slice(&new);
-                dissipation += w * (ddot6(&old, &old) + ddot6(&new, &new));
-            }
-            (sv, dissipation)
+            *cache.borrow()
         })
+    }
+
+    /// Update the Prony history for the strain increment `de` over a step `dt`; returns the
+    /// summed viscous stresses `sum_i h_i` and the step's dissipation.
+    #[inline(always)]
+    fn prony_update<R: Real>(&self, dt: f64, de: &Sym6<R>, hs: &mut [R]) -> (Sym6<R>, R) {
+        let factors = self.prony_factors(dt);
+        let mut sv: Sym6<R> = [R::zero(); 6];
+        let mut dissipation = R::zero();
+        for (h, &[a, g, w]) in hs.chunks_exact_mut(6).zip(&factors.f[..self.np]) {
+            let old: Sym6<R> = [h[0], h[1], h[2], h[3], h[4], h[5]];
+            let mut new: Sym6<R> = [R::zero(); 6];
+            for k in 0..6 {
+                new[k] = old[k] * a + de[k] * g;
+                sv[k] += new[k];
+            }
+            h.copy_from_slice(&new);
+            dissipation += (ddot6(&old, &old) + ddot6(&new, &new)) * w;
+        }
+        (sv, dissipation)
     }
 
     /// Principal Kirchhoff stresses of the elastic (long-term) part, the stretch-stiffened shear
     /// modulus bound and the largest |tau_iso|.
     #[inline(always)]
-    fn elastic_kirchhoff(&self, p: &Principal) -> ([f64; 3], f64, f64) {
+    fn elastic_kirchhoff<R: Real>(&self, p: &Principal<R>) -> ([R; 3], R, R) {
         let lb = p.ln_isochoric();
-        let mut tau = [0.0; 3];
-        let mut mu_eff = 0.0;
+        let mut tau = [R::zero(); 3];
+        let mut mu_eff = R::zero();
         for k in 0..self.n {
             let (m, a) = (self.mu[k], self.alpha[k]);
-            let e = [(a * lb[0]).exp(), (a * lb[1]).exp(), (a * lb[2]).exp()];
+            let e = [(lb[0] * a).exp(), (lb[1] * a).exp(), (lb[2] * a).exp()];
             let mean = (e[0] + e[1] + e[2]) * (1.0 / 3.0);
-            tau[0] += m * (e[0] - mean);
-            tau[1] += m * (e[1] - mean);
-            tau[2] += m * (e[2] - mean);
-            mu_eff += self.half_abs_mu_alpha[k] * e[0].max(e[1]).max(e[2]);
+            tau[0] += (e[0] - mean) * m;
+            tau[1] += (e[1] - mean) * m;
+            tau[2] += (e[2] - mean) * m;
+            mu_eff += e[0].max(e[1]).max(e[2]) * self.half_abs_mu_alpha[k];
         }
         let tmax = tau[0].abs().max(tau[1].abs()).max(tau[2].abs());
-        let pk = self.bulk * p.ln_j;
+        let pk = p.ln_j * self.bulk;
         ([tau[0] + pk, tau[1] + pk, tau[2] + pk], mu_eff, tmax)
     }
 }
@@ -402,24 +410,23 @@ impl Law for Ogden {
         mu_eff + 0.75 * self.visc_modulus_factor() * g
     }
 
-    #[inline]
-    fn evaluate(&self, f: &Mat3, dt: f64, history: &mut [f64]) -> Result<Response, LawError> {
-        checked_jacobian(f)?;
-        let p = Principal::of(f)?;
+    fn name(&self) -> &'static str {
+        "ogden"
+    }
+
+    #[inline(always)]
+    fn stress<R: Real>(&self, f: &M3<R>, dt: f64, history: &mut [R]) -> LawOut<R> {
+        let j = det(f);
+        let (p, collapsed) = Principal::of(f);
         let (tau, mu_eff, tmax) = self.elastic_kirchhoff(&p);
         let mut pk2 = p.pk2_from_kirchhoff(&tau);
-        let mut m = self.bulk * (1.0 - 2.0 * p.ln_j).max(1.0) + 4.0 / 3.0 * mu_eff + 2.0 * tmax;
-        let mut dissipation = 0.0;
+        let mut m = (R::splat(1.0) - p.ln_j * 2.0).max(R::splat(1.0)) * self.bulk
+            + mu_eff * (4.0 / 3.0)
+            + tmax * 2.0;
+        let mut dissipation = R::zero();
         if self.np > 0 {
             let c1 = &p.c_minus_i;
-            let mut e: Sym6 = [
-                0.5 * c1[0],
-                0.5 * c1[1],
-                0.5 * c1[2],
-                0.5 * c1[3],
-                0.5 * c1[4],
-                0.5 * c1[5],
-            ];
+            let mut e: Sym6<R> = crate::arr![6, |k| c1[k] * 0.5];
             if self.prony_on == PronyOn::Deviatoric {
                 let t = (e[0] + e[1] + e[2]) * (1.0 / 3.0);
                 e[0] -= t;
@@ -427,8 +434,8 @@ impl Law for Ogden {
                 e[2] -= t;
             }
             let (hs, eprev) = history.split_at_mut(6 * self.np);
-            let eprev: &mut [f64] = &mut eprev[..6];
-            let mut de = [0.0; 6];
+            let eprev: &mut [R] = &mut eprev[..6];
+            let mut de = [R::zero(); 6];
             for k in 0..6 {
                 de[k] = e[k] - eprev[k];
                 eprev[k] = e[k];
@@ -440,24 +447,27 @@ impl Law for Ogden {
             dissipation = d;
             // exp(4 ln l_max) = l_max^4.
             let l2max = p.stretch_sq[0].max(p.stretch_sq[1]).max(p.stretch_sq[2]);
-            m += self.visc_modulus_factor() * self.prony_sum * (l2max * l2max).max(1.0);
+            m += (l2max * l2max).max(R::splat(1.0)) * (self.visc_modulus_factor() * self.prony_sum);
         }
         let wave_speed = (m / self.rho).sqrt();
-        if !(wave_speed.is_finite() && all_finite6(&pk2) && dissipation.is_finite()) {
-            return Err(LawError::NotFinite("ogden"));
-        }
-        Ok(Response {
-            pk2: mat_from_sym6(&pk2),
+        let finite = wave_speed.is_finite() & all_finite6(&pk2) & dissipation.is_finite();
+        let (fault, fault_value) = faults(j, collapsed, finite);
+        LawOut {
+            pk2: full(&pk2),
             wave_speed,
             dissipation,
-            failed: false,
-        })
+            failed: R::Mask::splat(false),
+            fault,
+            fault_value,
+        }
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    #[allow(unused_imports)]
+    use crate::law::{LawError, Mat3};
     use nalgebra::{Rotation3, Vector3};
 
     const MU: [f64; 3] = [89.14, 9.965, -92.75];

@@ -48,8 +48,10 @@
 //! of reference volume; exact for linear hardening). Failure: with `failure_strain`, the point
 //! reports `failed` once `eps_p >= failure_strain`. Wave speed: `sqrt((K + 4/3 G) / rho)`.
 
-use crate::law::{checked_jacobian, Law, LawError, Mat3, Response};
-use crate::principal::{all_finite6, b_minus_identity, mat_from_sym6, sandwich6, Sym6, SymEigen};
+use crate::law::{faults, full, Law, LawOut};
+use crate::principal::{all_finite6, b_minus_identity, sandwich6, Sym6, SymEigen};
+use crate::real::{Mask, Real};
+use crate::tensor::{cofactor, det, M3};
 
 /// Piecewise-linear J2 plasticity.
 #[derive(Clone, Debug)]
@@ -221,101 +223,117 @@ impl Law for Plasticity {
         self.shear
     }
 
-    #[inline]
-    fn evaluate(&self, f: &Mat3, _dt: f64, history: &mut [f64]) -> Result<Response, LawError> {
-        let j = checked_jacobian(f)?;
+    fn name(&self) -> &'static str {
+        "piecewise_linear_plasticity"
+    }
+
+    /// The trial state is formed in every lane; the return mapping runs where the mask of
+    /// plastic lanes is set (the segment search of the hardening table per lane), and the
+    /// history changes only there.
+    #[inline(always)]
+    fn stress<R: Real>(&self, f: &M3<R>, _dt: f64, history: &mut [R]) -> LawOut<R> {
+        let j = det(f);
         let ep = history[0];
-        let q: Sym6 = [
+        let q: Sym6<R> = [
             history[1], history[2], history[3], history[4], history[5], history[6],
         ];
         // b_e^tr - I = (b - I) + F Q F^T with Q = C_p^-1 - I.
         let bm = b_minus_identity(f);
-        let mut a = bm;
-        if q.iter().any(|x| *x != 0.0) {
-            let fq = sandwich6(f, &q);
-            for k in 0..6 {
-                a[k] += fq[k];
-            }
-        }
-        let eig = SymEigen::of(&a);
+        let fq = sandwich6(f, &q);
+        let a: Sym6<R> = crate::arr![6, |k| bm[k] + fq[k]];
+        let (eig, mut collapsed) = SymEigen::decompose(&a);
         let ev = eig.values;
-        let mut eps = [0.0; 3];
-        for i in 0..3 {
-            if !(ev[i] > -1.0) {
-                return Err(LawError::NotFinite("elastic stretch collapsed"));
-            }
-            eps[i] = 0.5 * ev[i].ln_1p();
+        for x in ev {
+            collapsed = collapsed | !x.gt(R::splat(-1.0));
         }
+        let eps = [
+            ev[0].ln_1p() * 0.5,
+            ev[1].ln_1p() * 0.5,
+            ev[2].ln_1p() * 0.5,
+        ];
         let ev_vol = eps[0] + eps[1] + eps[2];
         let m = ev_vol * (1.0 / 3.0);
         let mut dev = [eps[0] - m, eps[1] - m, eps[2] - m];
         let g2 = 2.0 * self.shear;
         // q_tr^2 = 3/2 |2 G dev eps|^2, compared squared: no square root on the elastic path
         // (q_tr > sy, also for a curve softened below zero).
-        let q_tr2 = 1.5 * g2 * g2 * (dev[0] * dev[0] + dev[1] * dev[1] + dev[2] * dev[2]);
-        let sy = self.yield_stress(ep);
-        let mut dissipation = 0.0;
+        let q_tr2 = (dev[0] * dev[0] + dev[1] * dev[1] + dev[2] * dev[2]) * (1.5 * g2 * g2);
+        let mut sy = R::zero();
+        for l in 0..R::LANES {
+            sy.set_lane(l, self.yield_stress(ep.lane(l)));
+        }
+        let plastic = q_tr2.gt(sy * sy) | sy.lt(R::zero());
+        let mut dissipation = R::zero();
         let mut ep_new = ep;
-        let plastic = q_tr2 > sy * sy || sy < 0.0;
-        if plastic {
+        if plastic.any() {
             let q_tr = q_tr2.sqrt();
-            let dg = self.return_map(q_tr, ep, sy);
-            let factor = 1.0 - 3.0 * self.shear * dg / q_tr;
+            let mut dg = R::zero();
+            let mut sy_new = sy;
+            for l in 0..R::LANES {
+                if plastic.lane(l) {
+                    let d = self.return_map(q_tr.lane(l), ep.lane(l), sy.lane(l));
+                    dg.set_lane(l, d);
+                    sy_new.set_lane(l, self.yield_stress(ep.lane(l) + d));
+                }
+            }
+            let factor = R::select(
+                plastic,
+                R::splat(1.0) - dg * (3.0 * self.shear) / q_tr,
+                R::splat(1.0),
+            );
             for d in dev.iter_mut() {
                 *d *= factor;
             }
             ep_new = ep + dg;
-            dissipation = 0.5 * (sy + self.yield_stress(ep_new)) * dg;
+            dissipation = R::select(plastic, (sy + sy_new) * 0.5 * dg, R::zero());
         }
-        let p = self.bulk * ev_vol;
-        let tau = [g2 * dev[0] + p, g2 * dev[1] + p, g2 * dev[2] + p];
+        let p = ev_vol * self.bulk;
+        let tau = [dev[0] * g2 + p, dev[1] * g2 + p, dev[2] * g2 + p];
         // F^-1 = cof(F)^T / J.
-        let ij = 1.0 / j;
-        let fi = Mat3::new(
-            (f[(1, 1)] * f[(2, 2)] - f[(1, 2)] * f[(2, 1)]) * ij,
-            (f[(0, 2)] * f[(2, 1)] - f[(0, 1)] * f[(2, 2)]) * ij,
-            (f[(0, 1)] * f[(1, 2)] - f[(0, 2)] * f[(1, 1)]) * ij,
-            (f[(1, 2)] * f[(2, 0)] - f[(1, 0)] * f[(2, 2)]) * ij,
-            (f[(0, 0)] * f[(2, 2)] - f[(0, 2)] * f[(2, 0)]) * ij,
-            (f[(0, 2)] * f[(1, 0)] - f[(0, 0)] * f[(1, 2)]) * ij,
-            (f[(1, 0)] * f[(2, 1)] - f[(1, 1)] * f[(2, 0)]) * ij,
-            (f[(0, 1)] * f[(2, 0)] - f[(0, 0)] * f[(2, 1)]) * ij,
-            (f[(0, 0)] * f[(1, 1)] - f[(0, 1)] * f[(1, 0)]) * ij,
-        );
+        let cof = cofactor(f);
+        let ij = R::splat(1.0) / j;
+        let fi: M3<R> = crate::arr![3, |r| crate::arr![3, |c| cof[c][r] * ij]];
         // S = F^-1 tau F^-T.
         let pk2 = sandwich6(&fi, &eig.spectral6(&tau));
-        if plastic {
+        if plastic.any() {
             // C_p^-1 - I = F^-1 (b_e - b) F^-T, with b_e - b = (b_e - I) - (b - I): both
             // differences are accurate at small strain, and an elastic step would return Q.
             let e2 = [
-                (2.0 * (dev[0] + m)).exp_m1(),
-                (2.0 * (dev[1] + m)).exp_m1(),
-                (2.0 * (dev[2] + m)).exp_m1(),
+                ((dev[0] + m) * 2.0).exp_m1(),
+                ((dev[1] + m) * 2.0).exp_m1(),
+                ((dev[2] + m) * 2.0).exp_m1(),
             ];
             let mut d = eig.spectral6(&e2);
             for k in 0..6 {
                 d[k] -= bm[k];
             }
             let qn = sandwich6(&fi, &d);
-            history[0] = ep_new;
-            history[1..7].copy_from_slice(&qn);
+            history[0] = R::select(plastic, ep_new, ep);
+            for k in 0..6 {
+                history[1 + k] = R::select(plastic, qn[k], q[k]);
+            }
         }
-        let failed = matches!(self.failure_strain, Some(fs) if ep_new >= fs);
-        if !all_finite6(&pk2) {
-            return Err(LawError::NotFinite("piecewise_linear_plasticity"));
-        }
-        Ok(Response {
-            pk2: mat_from_sym6(&pk2),
-            wave_speed: self.initial_wave_speed(),
+        let failed = match self.failure_strain {
+            Some(fs) => ep_new.ge(R::splat(fs)),
+            None => R::Mask::splat(false),
+        };
+        let (fault, fault_value) = faults(j, collapsed, all_finite6(&pk2));
+        LawOut {
+            pk2: full(&pk2),
+            wave_speed: R::splat(self.initial_wave_speed()),
             dissipation,
             failed,
-        })
+            fault,
+            fault_value,
+        }
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    #[allow(unused_imports)]
+    use crate::law::{LawError, Mat3};
     use nalgebra::{Rotation3, Vector3};
 
     fn ribs() -> Plasticity {

@@ -29,10 +29,12 @@
 //! Symmetric tensors are stored as `[xx, yy, zz, xy, yz, zx]` (the "Sym6" order used for
 //! history values and output columns).
 
-use crate::law::{LawError, Mat3};
+use crate::law::Mat3;
+use crate::real::{Mask, Real};
+use crate::tensor::M3;
 
 /// Symmetric tensor in the order `[xx, yy, zz, xy, yz, zx]`.
-pub type Sym6 = [f64; 6];
+pub type Sym6<R = f64> = [R; 6];
 
 /// Symmetric part of a matrix as Sym6.
 #[inline(always)]
@@ -55,30 +57,43 @@ pub fn mat_from_sym6(s: &Sym6) -> Mat3 {
 
 /// Double contraction `a : b` of two symmetric tensors.
 #[inline(always)]
-pub fn ddot6(a: &Sym6, b: &Sym6) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2] + 2.0 * (a[3] * b[3] + a[4] * b[4] + a[5] * b[5])
+pub fn ddot6<R: Real>(a: &Sym6<R>, b: &Sym6<R>) -> R {
+    a[0] * b[0] + a[1] * b[1] + a[2] * b[2] + (a[3] * b[3] + a[4] * b[4] + a[5] * b[5]) * 2.0
 }
 
 /// `C - I = H + H^T + H^T H` with `H = F - I`, as Sym6 (twice the Green-Lagrange strain),
 /// accurate at small strain.
 #[inline(always)]
-pub fn c_minus_identity(f: &Mat3) -> Sym6 {
-    let h = f - Mat3::identity();
-    let hth = h.transpose() * h;
+pub fn c_minus_identity<R: Real>(f: &M3<R>) -> Sym6<R> {
+    let mut h = *f;
+    for i in 0..3 {
+        h[i][i] -= R::splat(1.0);
+    }
+    // (H^T H)_ij = sum_k H_ki H_kj.
+    macro_rules! hth {
+        ($i:expr, $j:expr) => {
+            h[0][$i] * h[0][$j] + h[1][$i] * h[1][$j] + h[2][$i] * h[2][$j]
+        };
+    }
     [
-        2.0 * h[(0, 0)] + hth[(0, 0)],
-        2.0 * h[(1, 1)] + hth[(1, 1)],
-        2.0 * h[(2, 2)] + hth[(2, 2)],
-        h[(0, 1)] + h[(1, 0)] + hth[(0, 1)],
-        h[(1, 2)] + h[(2, 1)] + hth[(1, 2)],
-        h[(2, 0)] + h[(0, 2)] + hth[(2, 0)],
+        h[0][0] * 2.0 + hth!(0, 0),
+        h[1][1] * 2.0 + hth!(1, 1),
+        h[2][2] * 2.0 + hth!(2, 2),
+        h[0][1] + h[1][0] + hth!(0, 1),
+        h[1][2] + h[2][1] + hth!(1, 2),
+        h[2][0] + h[0][2] + hth!(2, 0),
     ]
 }
 
 /// `b - I = H + H^T + H H^T` with `H = F - I` (left Cauchy-Green tensor minus identity).
 #[inline(always)]
-pub fn b_minus_identity(f: &Mat3) -> Sym6 {
-    c_minus_identity(&f.transpose())
+pub fn b_minus_identity<R: Real>(f: &M3<R>) -> Sym6<R> {
+    let t = [
+        [f[0][0], f[1][0], f[2][0]],
+        [f[0][1], f[1][1], f[2][1]],
+        [f[0][2], f[1][2], f[2][2]],
+    ];
+    c_minus_identity(&t)
 }
 
 /// One Jacobi rotation zeroing `a[p][q]`; `r` is the third index. Off-diagonal terms at or
@@ -159,7 +174,7 @@ pub fn sym_eigen_jacobi(m: &Sym6) -> ([f64; 3], Mat3) {
 }
 
 #[inline(always)]
-fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+fn cross<R: Real>(a: [R; 3], b: [R; 3]) -> [R; 3] {
     [
         a[1] * b[2] - a[2] * b[1],
         a[2] * b[0] - a[0] * b[2],
@@ -168,7 +183,7 @@ fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
 }
 
 #[inline(always)]
-fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
+fn dot<R: Real>(a: [R; 3], b: [R; 3]) -> R {
     a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }
 
@@ -185,7 +200,7 @@ fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {
 /// as accurate as `(r.acos() / 3.0).cos()` and without its two library calls.
 /// `g' = 12c^2 - 3 >= 6` on the interval, so the step is well conditioned.
 #[inline(always)]
-fn cos_third_acos(r: f64) -> f64 {
+fn cos_third_acos<R: Real>(r: R) -> R {
     const P: [f64; 11] = [
         0.866_025_403_824_073_7,
         0.166_666_657_041_595_22,
@@ -213,53 +228,52 @@ fn cos_third_acos(r: f64) -> f64 {
     let r2 = r * r;
     let r4 = r2 * r2;
     let r8 = r4 * r4;
-    let a = (P[0] + P[1] * r) + (P[2] + P[3] * r) * r2;
-    let b = (P[4] + P[5] * r) + (P[6] + P[7] * r) * r2;
-    let d = (P[8] + P[9] * r) + P[10] * r2;
+    let a = (r * P[1] + P[0]) + (r * P[3] + P[2]) * r2;
+    let b = (r * P[5] + P[4]) + (r * P[7] + P[6]) * r2;
+    let d = (r * P[9] + P[8]) + r2 * P[10];
     let c = (a + b * r4) + d * r8;
-    let qa = (Q[0] + Q[1] * r) + (Q[2] + Q[3] * r) * r2;
-    let qb = (Q[4] + Q[5] * r) + (Q[6] + Q[7] * r) * r2;
+    let qa = (r * Q[1] + Q[0]) + (r * Q[3] + Q[2]) * r2;
+    let qb = (r * Q[5] + Q[4]) + (r * Q[7] + Q[6]) * r2;
     let inv_g1 = qa + qb * r4;
-    c - (c * (4.0 * c * c - 3.0) - r) * inv_g1
+    c - (c * (c * c * 4.0 - 3.0) - r) * inv_g1
 }
 
-/// First stage shared by [`SymEigen::of`] and [`sym_eigen`]: the isolated eigenvalue and its
-/// eigenvector (see [`SymEigen`] for the method).
-enum Isolated {
-    /// `tr(B^2)/6 <= 1e-280`: isotropic to round-off (or below underflow).
-    Isotropic,
-    /// Non-finite input (the eigenvector bound failed).
-    NonFinite,
-    /// `A = mean I + p Bn`; `mu0` is the isolated eigenvalue of `Bn`, `v` (with `nv = |v|^2`,
-    /// `12 <= nv <= 81`) an unnormalised eigenvector of it.
-    Found {
-        mean: f64,
-        p: f64,
-        bn: Sym6,
-        mu0: f64,
-        v: [f64; 3],
-        nv: f64,
-    },
+/// First stage shared by [`SymEigen::decompose`] and [`sym_eigen`]: the isolated eigenvalue and
+/// its eigenvector (see [`SymEigen`] for the method), for every lane at once.
+///
+/// `A = mean I + p Bn`; `mu0` is the isolated eigenvalue of `Bn`, `v` (with `nv = |v|^2`,
+/// `12 <= nv <= 81`) an unnormalised eigenvector of it. Lanes with `tr(B^2)/6 <= 1e-280`
+/// (isotropic to round-off, or below underflow, or NaN) are marked `iso` and computed with
+/// `p = 1` so that nothing else divides by zero; lanes whose eigenvector bound fails (only a
+/// non-finite input gets there) are marked `bad`.
+struct Isolated<R: Real> {
+    mean: R,
+    p: R,
+    bn: Sym6<R>,
+    mu0: R,
+    v: [R; 3],
+    nv: R,
+    iso: R::Mask,
+    bad: R::Mask,
 }
 
 #[inline(always)]
-fn isolated(m: &Sym6) -> Isolated {
+fn isolated<R: Real>(m: &Sym6<R>) -> Isolated<R> {
     let mean = (m[0] + m[1] + m[2]) * (1.0 / 3.0);
     let b = [m[0] - mean, m[1] - mean, m[2] - mean, m[3], m[4], m[5]];
     let p2 =
-        (b[0] * b[0] + b[1] * b[1] + b[2] * b[2] + 2.0 * (b[3] * b[3] + b[4] * b[4] + b[5] * b[5]))
+        (b[0] * b[0] + b[1] * b[1] + b[2] * b[2] + (b[3] * b[3] + b[4] * b[4] + b[5] * b[5]) * 2.0)
             * (1.0 / 6.0);
-    if !(p2 > 1e-280) {
-        return Isolated::Isotropic;
-    }
+    let iso = !p2.gt(R::splat(1e-280));
+    let p2 = R::select(iso, R::splat(1.0), p2);
     let p = p2.sqrt();
-    let ip2 = 1.0 / p2;
+    let ip2 = R::splat(1.0) / p2;
     let ip = p * ip2;
     let det = b[0] * (b[1] * b[2] - b[4] * b[4]) - b[3] * (b[3] * b[2] - b[4] * b[5])
         + b[5] * (b[3] * b[4] - b[1] * b[5]);
-    let r = (0.5 * det.abs() * (ip2 * ip)).min(1.0);
-    let c2 = 2.0 * cos_third_acos(r);
-    let mu0 = if det >= 0.0 { c2 } else { -c2 };
+    let r = (det.abs() * 0.5 * (ip2 * ip)).min(R::splat(1.0));
+    let c2 = cos_third_acos(r) * 2.0;
+    let mu0 = R::select(det.ge(R::zero()), c2, -c2);
     let bn = [
         b[0] * ip,
         b[1] * ip,
@@ -278,25 +292,26 @@ fn isolated(m: &Sym6) -> Isolated {
     let m0 = n1 * n2 - bn[4] * bn[4];
     let m1 = n0 * n2 - bn[5] * bn[5];
     let m2 = n0 * n1 - bn[3] * bn[3];
-    let v = if m0 >= m1 && m0 >= m2 {
-        cross(r1, r2)
-    } else if m1 >= m2 {
-        cross(r2, r0)
-    } else {
-        cross(r0, r1)
-    };
+    let first = m0.ge(m1) & m0.ge(m2);
+    let second = m1.ge(m2);
+    let (c12, c20, c01) = (cross(r1, r2), cross(r2, r0), cross(r0, r1));
+    let v: [R; 3] = crate::arr![3, |k| R::select(
+        first,
+        c12[k],
+        R::select(second, c20[k], c01[k])
+    )];
     let nv = dot(v, v);
-    if !(nv > 1.0 && nv < 1e3) {
-        // 12 <= nv <= 81 in exact arithmetic: only a non-finite input gets here.
-        return Isolated::NonFinite;
-    }
-    Isolated::Found {
+    // 12 <= nv <= 81 in exact arithmetic: only a non-finite input fails this.
+    let bad = !(nv.gt(R::splat(1.0)) & nv.lt(R::splat(1e3))) & !iso;
+    Isolated {
         mean,
         p,
         bn,
         mu0,
         v,
         nv,
+        iso,
+        bad,
     }
 }
 
@@ -343,44 +358,44 @@ fn isolated(m: &Sym6) -> Isolated {
 /// random, degenerate and nearly degenerate matrices, and for reconstruction
 /// (`sum lambda_i N_i (x) N_i = A`) and the projector identities.
 #[derive(Clone, Copy, Debug)]
-pub struct SymEigen {
+pub struct SymEigen<R: Real = f64> {
     /// Eigenvalues: the isolated one, then the larger and the smaller of the pair.
-    pub values: [f64; 3],
+    pub values: [R; 3],
     /// `V = N_0 (x) N_0`, as Sym6.
-    pub proj: Sym6,
+    pub proj: Sym6<R>,
     /// `D = (N_1 (x) N_1 - N_2 (x) N_2) / 2`, as Sym6.
-    pub half_diff: Sym6,
+    pub half_diff: Sym6<R>,
 }
 
-impl SymEigen {
+impl SymEigen<f64> {
     /// Decompose a symmetric tensor given as Sym6.
     #[inline(always)]
     pub fn of(m: &Sym6) -> SymEigen {
-        let (mean, p, bn, mu0, v, nv) = match isolated(m) {
-            Isolated::Found {
-                mean,
-                p,
-                bn,
-                mu0,
-                v,
-                nv,
-            } => (mean, p, bn, mu0, v, nv),
-            Isolated::Isotropic => {
-                // Any basis: the coordinate axes.
-                return SymEigen {
-                    values: [m[0], m[1], m[2]],
-                    proj: [1.0, 0.0, 0.0, 0.0, 0.0, 0.0],
-                    half_diff: [0.0, 0.5, -0.5, 0.0, 0.0, 0.0],
-                };
-            }
-            Isolated::NonFinite => {
-                let (l, n) = sym_eigen_jacobi(m);
-                return SymEigen::from_vectors(l, &n);
-            }
-        };
+        SymEigen::decompose(m).0
+    }
+}
+
+impl<R: Real> SymEigen<R> {
+    /// Decompose a symmetric tensor in every lane; the mask marks lanes with a non-finite input,
+    /// whose result is meaningless. Lanes where the adjugate step cannot certify its eigenvector
+    /// (a non-finite input, or a deviator so small against the mean that its scaled form is
+    /// rounding noise, e.g. a uniform dilatation) are redone by [`sym_eigen_jacobi`], one lane at
+    /// a time: a rare path.
+    #[inline(always)]
+    pub fn decompose(m: &Sym6<R>) -> (SymEigen<R>, R::Mask) {
+        let Isolated {
+            mean,
+            p,
+            bn,
+            mu0,
+            v,
+            nv,
+            iso,
+            bad,
+        } = isolated(m);
         // nv Q, so that no division by nv precedes the norm: h = |nv Q|_F / (sqrt 2 nv).
-        let inv_nv = 1.0 / nv;
-        let mid = 0.5 * ((bn[0] + bn[1] + bn[2]) - mu0);
+        let inv_nv = R::splat(1.0) / nv;
+        let mid = ((bn[0] + bn[1] + bn[2]) - mu0) * 0.5;
         let k = mu0 - mid;
         let q = [
             nv * (bn[0] - mid) - k * (v[0] * v[0]),
@@ -390,25 +405,86 @@ impl SymEigen {
             nv * bn[4] - k * (v[1] * v[2]),
             nv * bn[5] - k * (v[2] * v[0]),
         ];
-        let h2 = 0.5 * ddot6(&q, &q);
+        let h2 = ddot6(&q, &q) * 0.5;
         let hs = h2.sqrt();
         let h = hs * inv_nv;
         // D = Q / (2h) = (nv Q) / (2 |nv Q|_F / sqrt 2).
-        let g = if h2 > 0.0 { 0.5 / hs } else { 0.0 };
-        SymEigen {
-            values: [mean + p * mu0, mean + p * (mid + h), mean + p * (mid - h)],
-            proj: [
-                v[0] * v[0] * inv_nv,
-                v[1] * v[1] * inv_nv,
-                v[2] * v[2] * inv_nv,
-                v[0] * v[1] * inv_nv,
-                v[1] * v[2] * inv_nv,
-                v[2] * v[0] * inv_nv,
-            ],
-            half_diff: [q[0] * g, q[1] * g, q[2] * g, q[3] * g, q[4] * g, q[5] * g],
+        let pos = h2.gt(R::zero());
+        let g = R::select(
+            pos,
+            R::splat(0.5) / R::select(pos, hs, R::splat(1.0)),
+            R::zero(),
+        );
+        let (z, one, half) = (R::zero(), R::splat(1.0), R::splat(0.5));
+        // Isotropic lanes: any basis, the coordinate axes.
+        macro_rules! sel {
+            ($a:expr, $b:expr) => {
+                R::select(iso, $b, $a)
+            };
         }
+        let e = SymEigen {
+            values: [
+                sel!(mean + p * mu0, m[0]),
+                sel!(mean + p * (mid + h), m[1]),
+                sel!(mean + p * (mid - h), m[2]),
+            ],
+            proj: [
+                sel!(v[0] * v[0] * inv_nv, one),
+                sel!(v[1] * v[1] * inv_nv, z),
+                sel!(v[2] * v[2] * inv_nv, z),
+                sel!(v[0] * v[1] * inv_nv, z),
+                sel!(v[1] * v[2] * inv_nv, z),
+                sel!(v[2] * v[0] * inv_nv, z),
+            ],
+            half_diff: [
+                sel!(q[0] * g, z),
+                sel!(q[1] * g, half),
+                sel!(q[2] * g, -half),
+                sel!(q[3] * g, z),
+                sel!(q[4] * g, z),
+                sel!(q[5] * g, z),
+            ],
+        };
+        let mut e = e;
+        if bad.any() {
+            for l in 0..R::LANES {
+                if bad.lane(l) {
+                    let ml: Sym6 = crate::arr![6, |k| m[k].lane(l)];
+                    let (vals, n) = sym_eigen_jacobi(&ml);
+                    let el = SymEigen::from_vectors(vals, &n);
+                    for k in 0..3 {
+                        e.values[k].set_lane(l, el.values[k]);
+                    }
+                    for k in 0..6 {
+                        e.proj[k].set_lane(l, el.proj[k]);
+                        e.half_diff[k].set_lane(l, el.half_diff[k]);
+                    }
+                }
+            }
+        }
+        let finite = all_finite6(m);
+        (e, !finite)
     }
 
+    /// `sum_i c_i N_i (x) N_i = cm I + (c_0 - cm) V + (c_1 - c_2) D`, as Sym6.
+    #[inline(always)]
+    pub fn spectral6(&self, c: &[R; 3]) -> Sym6<R> {
+        let cm = (c[1] + c[2]) * 0.5;
+        let a = c[0] - cm;
+        let g = c[1] - c[2];
+        let (v, d) = (&self.proj, &self.half_diff);
+        [
+            cm + a * v[0] + g * d[0],
+            cm + a * v[1] + g * d[1],
+            cm + a * v[2] + g * d[2],
+            a * v[3] + g * d[3],
+            a * v[4] + g * d[4],
+            a * v[5] + g * d[5],
+        ]
+    }
+}
+
+impl SymEigen<f64> {
     /// From eigenvalues and orthonormal eigenvectors (the columns of `n`).
     pub fn from_vectors(values: [f64; 3], n: &Mat3) -> SymEigen {
         let outer = |k: usize| {
@@ -432,23 +508,6 @@ impl SymEigen {
             half_diff: d,
         }
     }
-
-    /// `sum_i c_i N_i (x) N_i`, as Sym6.
-    #[inline(always)]
-    pub fn spectral6(&self, c: &[f64; 3]) -> Sym6 {
-        let cm = 0.5 * (c[1] + c[2]);
-        let a = c[0] - cm;
-        let g = c[1] - c[2];
-        let (v, d) = (&self.proj, &self.half_diff);
-        [
-            cm + a * v[0] + g * d[0],
-            cm + a * v[1] + g * d[1],
-            cm + a * v[2] + g * d[2],
-            a * v[3] + g * d[3],
-            a * v[4] + g * d[4],
-            a * v[5] + g * d[5],
-        ]
-    }
 }
 
 /// Eigenvalues and orthonormal eigenvectors (the columns of the returned matrix) of a symmetric
@@ -471,13 +530,22 @@ impl SymEigen {
 /// stresses stay accurate to round-off of `|A|` (tested against [`sym_eigen_jacobi`]).
 #[inline]
 pub fn sym_eigen(m: &Sym6) -> ([f64; 3], Mat3) {
-    let (mean, p, bn, v, nv) = match isolated(m) {
-        Isolated::Found {
-            mean, p, bn, v, nv, ..
-        } => (mean, p, bn, v, nv),
-        Isolated::Isotropic => return ([m[0], m[1], m[2]], Mat3::identity()),
-        Isolated::NonFinite => return sym_eigen_jacobi(m),
-    };
+    let Isolated {
+        mean,
+        p,
+        bn,
+        v,
+        nv,
+        iso,
+        bad,
+        ..
+    } = isolated(m);
+    if iso {
+        return ([m[0], m[1], m[2]], Mat3::identity());
+    }
+    if bad {
+        return sym_eigen_jacobi(m);
+    }
     let (ax, ay, az) = (v[0].abs(), v[1].abs(), v[2].abs());
     let u = if ax <= ay && ax <= az {
         [0.0, v[2], -v[1]]
@@ -545,7 +613,7 @@ pub fn sym_eigen(m: &Sym6) -> ([f64; 3], Mat3) {
 
 /// `M a` for a symmetric `M` given as Sym6.
 #[inline(always)]
-fn mul6(m: &Sym6, a: [f64; 3]) -> [f64; 3] {
+fn mul6<R: Real>(m: &Sym6<R>, a: [R; 3]) -> [R; 3] {
     [
         m[0] * a[0] + m[3] * a[1] + m[5] * a[2],
         m[3] * a[0] + m[1] * a[1] + m[4] * a[2],
@@ -555,54 +623,51 @@ fn mul6(m: &Sym6, a: [f64; 3]) -> [f64; 3] {
 
 /// Principal logarithmic stretches of `F` and the reference principal directions.
 #[derive(Clone, Copy, Debug)]
-pub struct Principal {
+pub struct Principal<R: Real = f64> {
     /// `ln l_i`, the principal logarithmic (Hencky) strains.
-    pub ln_stretch: [f64; 3],
+    pub ln_stretch: [R; 3],
     /// `ln J = sum_i ln l_i`.
-    pub ln_j: f64,
+    pub ln_j: R,
     /// Spectral decomposition of `C - I` (eigenvalues `l_i^2 - 1`): the reference (Lagrangian)
     /// principal directions `N_i`, as the projectors that stresses `sum_i c_i N_i (x) N_i` need.
-    pub eigen: SymEigen,
+    pub eigen: SymEigen<R>,
     /// `l_i^2`, the eigenvalues of `C`.
-    pub stretch_sq: [f64; 3],
+    pub stretch_sq: [R; 3],
     /// `1 / l_i^2`, the eigenvalues of `C^-1`.
-    pub inv_stretch_sq: [f64; 3],
+    pub inv_stretch_sq: [R; 3],
     /// `C - I` (twice the Green-Lagrange strain), as Sym6: the tensor that was decomposed.
-    pub c_minus_i: Sym6,
+    pub c_minus_i: Sym6<R>,
 }
 
-impl Principal {
-    /// Decompose `F` (which must have a positive determinant: check it first).
+impl<R: Real> Principal<R> {
+    /// Decompose `F` (which must have a positive determinant: check it first). The mask marks
+    /// lanes whose input was not finite or whose stretch collapsed to zero (`l_i^2 - 1 <= -1`,
+    /// only possible through round-off at det F near 0): their result is meaningless.
     #[inline(always)]
-    pub fn of(f: &Mat3) -> Result<Principal, LawError> {
+    pub fn of(f: &M3<R>) -> (Principal<R>, R::Mask) {
         let c1 = c_minus_identity(f);
-        let eigen = SymEigen::of(&c1);
+        let (eigen, mut bad) = SymEigen::decompose(&c1);
         let a = eigen.values;
-        let mut ln = [0.0; 3];
-        let mut sq = [0.0; 3];
-        let mut inv = [0.0; 3];
-        for i in 0..3 {
-            // a_i > -1 for det F > 0 up to round-off; refuse a collapsed direction.
-            if !(a[i] > -1.0) {
-                return Err(LawError::NotFinite("principal stretch collapsed to zero"));
-            }
-            ln[i] = 0.5 * a[i].ln_1p();
-            sq[i] = 1.0 + a[i];
-            inv[i] = 1.0 / sq[i];
+        for x in a {
+            bad = bad | !x.gt(R::splat(-1.0));
         }
-        Ok(Principal {
+        let ln = [a[0].ln_1p() * 0.5, a[1].ln_1p() * 0.5, a[2].ln_1p() * 0.5];
+        let sq = [a[0] + 1.0, a[1] + 1.0, a[2] + 1.0];
+        let one = R::splat(1.0);
+        let p = Principal {
             ln_stretch: ln,
             ln_j: ln[0] + ln[1] + ln[2],
             eigen,
             stretch_sq: sq,
-            inv_stretch_sq: inv,
+            inv_stretch_sq: [one / sq[0], one / sq[1], one / sq[2]],
             c_minus_i: c1,
-        })
+        };
+        (p, bad)
     }
 
     /// Isochoric logarithmic stretches `ln lbar_i = ln l_i - ln J / 3`.
     #[inline(always)]
-    pub fn ln_isochoric(&self) -> [f64; 3] {
+    pub fn ln_isochoric(&self) -> [R; 3] {
         let s = self.ln_j * (1.0 / 3.0);
         [
             self.ln_stretch[0] - s,
@@ -614,7 +679,7 @@ impl Principal {
     /// PK2 stress from principal Kirchhoff stresses, as Sym6:
     /// `S = sum_i tau_i / l_i^2 N_i (x) N_i`.
     #[inline(always)]
-    pub fn pk2_from_kirchhoff(&self, tau: &[f64; 3]) -> Sym6 {
+    pub fn pk2_from_kirchhoff(&self, tau: &[R; 3]) -> Sym6<R> {
         let c = [
             tau[0] * self.inv_stretch_sq[0],
             tau[1] * self.inv_stretch_sq[1],
@@ -626,18 +691,22 @@ impl Principal {
 
 /// `M S M^T` for a symmetric `S` given as Sym6, as Sym6.
 #[inline(always)]
-pub fn sandwich6(m: &Mat3, s: &Sym6) -> Sym6 {
+pub fn sandwich6<R: Real>(m: &M3<R>, s: &Sym6<R>) -> Sym6<R> {
     // T = M S (row i of M times S), then (T M^T)_ij = T_i . M_j.
-    let row = |i: usize| mul6(s, [m[(i, 0)], m[(i, 1)], m[(i, 2)]]);
-    let t = [row(0), row(1), row(2)];
-    let e = |i: usize, j: usize| t[i][0] * m[(j, 0)] + t[i][1] * m[(j, 1)] + t[i][2] * m[(j, 2)];
-    [e(0, 0), e(1, 1), e(2, 2), e(0, 1), e(1, 2), e(2, 0)]
+    let t = [mul6(s, m[0]), mul6(s, m[1]), mul6(s, m[2])];
+    macro_rules! e {
+        ($i:expr, $j:expr) => {
+            t[$i][0] * m[$j][0] + t[$i][1] * m[$j][1] + t[$i][2] * m[$j][2]
+        };
+    }
+    [e!(0, 0), e!(1, 1), e!(2, 2), e!(0, 1), e!(1, 2), e!(2, 0)]
 }
 
 /// Whether every component of a Sym6 is finite.
 #[inline(always)]
-pub fn all_finite6(s: &Sym6) -> bool {
-    s.iter().all(|x| x.is_finite())
+pub fn all_finite6<R: Real>(s: &Sym6<R>) -> R::Mask {
+    (s[0].is_finite() & s[1].is_finite() & s[2].is_finite())
+        & (s[3].is_finite() & s[4].is_finite() & s[5].is_finite())
 }
 
 /// `sum_i c_i n_i (x) n_i` for the columns `n_i` of `n`.
@@ -806,7 +875,7 @@ mod tests {
     fn small_strain_logs_are_accurate() {
         let eps = 1e-9;
         let f = Mat3::new(1.0 + eps, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0);
-        let p = Principal::of(&f).unwrap();
+        let p = Principal::of(&crate::tensor::from_mat3(&f)).0;
         let m = p.ln_stretch.iter().fold(0.0f64, |m, x| m.max(*x));
         assert!((m - (1.0 + eps).ln()).abs() < 1e-22, "{m:e}");
     }

@@ -1,16 +1,29 @@
 //! The internal-force stage: the parallel element loop and the race-free gather.
 //!
-//! Each element writes its eight nodal force vectors into its own slot of an element-force
-//! buffer; then every node sums its slots in a fixed order through the gather table. No two
-//! threads write the same memory, and every sum is formed in the same order whatever the
-//! thread count, so results are bitwise identical on 1 or N threads. Chunk partial results
-//! (minimum step, energy rates) are reduced serially in chunk order for the same reason.
+//! Elements are processed in batches of [`LANES`] (eight): the nodal displacements, velocities
+//! and coordinates of a batch are gathered into lane vectors (struct of arrays inside the batch),
+//! and one call of the element kernel evaluates the kinematics, the law, the internal and
+//! hourglass forces and the critical step of all eight ([`crate::element`], generic over
+//! [`material::real::Real`]). Reference data (gradients, hourglass vectors, Gauss-point data) and
+//! history are stored batch by batch in the same lane layout ([`crate::model::Group`]), so they
+//! load as whole vectors. The batch kernel is compiled twice: for AVX-512 (chosen at run time when
+//! the processor has it) and for the build's baseline (AVX2 with the project's `.cargo/config.toml`,
+//! SSE2 or NEON elsewhere); both perform the same IEEE operations in the same order, so results
+//! do not depend on which runs. `PALPA_SIMD=baseline` forces the baseline path.
+//!
+//! Each batch writes its eight elements' nodal force vectors into its own slot of an
+//! element-force buffer; then every node sums its slots in a fixed order through the gather
+//! table. No two threads write the same memory, and every sum is formed in the same order
+//! whatever the thread count, so results are bitwise identical on 1 or N threads. Chunk partial
+//! results (minimum step, energy rates) are reduced serially in chunk order, and inside a chunk
+//! element by element in element order, for the same reason.
 
-use crate::element::{full, one_point, ElementOut, Formulation, Nodal, StepInput};
+use crate::element::{fault_error, full, one_point, ElementOut, Formulation, Nodal, StepInput};
 use crate::model::{ChunkOut, Group, Model, Part, CHUNK};
-use material::with_law;
+use material::real::{F64x8, Mask, Real, LANES};
+use material::{with_law, Law};
 use rayon::prelude::*;
-
+use std::sync::OnceLock;
 /// Sum of the element loop's scalar outputs.
 #[derive(Clone, Copy, Debug, Default)]
 pub struct ElementTotals {
@@ -51,8 +64,45 @@ impl<T> Shared<T> {
     }
 }
 
-/// Run the element loop: fill `slots` with element forces and `stress` (if requested, indexed by
-/// global element id) with Cauchy stress; return totals or the first failing element.
+/// Which instruction set the batch kernels run with: `"avx512"` or `"baseline"`.
+pub fn simd_level() -> &'static str {
+    static LEVEL: OnceLock<&'static str> = OnceLock::new();
+    LEVEL.get_or_init(|| {
+        let forced = std::env::var("PALPA_SIMD")
+            .map(|v| v == "baseline")
+            .unwrap_or(false);
+        #[cfg(target_arch = "x86_64")]
+        {
+            if !forced
+                && std::arch::is_x86_feature_detected!("avx512f")
+                && std::arch::is_x86_feature_detected!("avx512dq")
+                && std::arch::is_x86_feature_detected!("avx512vl")
+                && std::arch::is_x86_feature_detected!("avx512bw")
+            {
+                return "avx512";
+            }
+        }
+        let _ = forced;
+        "baseline"
+    })
+}
+
+/// Everything a chunk of batches reads: one group's data and the step's state.
+struct Batch<'a> {
+    form: Formulation,
+    group: &'a Group,
+    x_ref: &'a [[f64; 3]],
+    u: &'a [[f64; 3]],
+    v: &'a [[f64; 3]],
+    input: &'a StepInput,
+    hist: Shared<F64x8>,
+    stress: Option<Shared<[f64; 6]>>,
+}
+
+/// Run the element loop: fill `slots` (one lane vector per force component and node, per batch)
+/// with element forces and `stress` (if requested, indexed by global element id) with Cauchy
+/// stress; return totals or the first failing element.
+#[allow(clippy::too_many_arguments)]
 pub fn element_loop(
     parts: &[Part],
     groups: &mut [Group],
@@ -60,7 +110,7 @@ pub fn element_loop(
     u: &[[f64; 3]],
     v: &[[f64; 3]],
     input: &StepInput,
-    slots: &mut [Nodal],
+    slots: &mut [Nodal<F64x8>],
     stress: Option<&mut [[f64; 6]]>,
 ) -> Result<ElementTotals, (u32, String)> {
     let stress_ptr = stress.map(|s| Shared(s.as_mut_ptr()));
@@ -70,107 +120,29 @@ pub fn element_loop(
     };
     for g in groups.iter_mut() {
         let part = &parts[g.part];
-        let form = part.formulation;
-        let law = &part.material;
         let n = g.elements.len();
-        let stride = g.history_stride;
+        let first = g.slot_offset / LANES;
+        let gslots = &mut slots[first..first + g.batches()];
+        let mut chunks = std::mem::take(&mut g.chunks);
         let hist = Shared(g.history.as_mut_ptr());
-        let gslots = &mut slots[g.slot_offset..g.slot_offset + n];
-        let (elements, conn, grad, vol0) = (&g.elements, &g.conn, &g.grad, &g.vol0);
-        let eroded = &g.eroded;
-        let dt_floor = g.dt_floor;
-        let (gamma, hgk, gpg, gpw, dscale) = (
-            &g.gamma,
-            &g.hg_scale,
-            &g.gp_grad,
-            &g.gp_weight,
-            &g.density_scale,
-        );
-        with_law!(law, l => {
-            gslots.par_chunks_mut(CHUNK).zip(g.chunks.par_iter_mut()).enumerate().for_each(|(ci, (fch, out))| {
-                let mut acc = ChunkOut { dt_min: f64::INFINITY, ..Default::default() };
-                for (k, fe) in fch.iter_mut().enumerate() {
-                    let le = ci * CHUNK + k;
-                    if !eroded.is_empty() && eroded[le] {
-                        *fe = [[0.0; 8]; 3];
-                        continue;
-                    }
-                    let c = &conn[le];
-                    let mut xe: Nodal = [[0.0; 8]; 3];
-                    let mut ue: Nodal = [[0.0; 8]; 3];
-                    let mut ve: Nodal = [[0.0; 8]; 3];
-                    for a in 0..8 {
-                        let nd = c[a] as usize;
-                        let (un, vn, xr) = (u[nd], v[nd], x_ref[nd]);
-                        for i in 0..3 {
-                            ue[i][a] = un[i];
-                            ve[i][a] = vn[i];
-                            xe[i][a] = xr[i] + un[i];
-                        }
-                    }
-                    let s = if dscale.is_empty() { 1.0 } else { dscale[le] };
-                    // SAFETY: element le owns history[le*stride..(le+1)*stride] alone.
-                    let h = unsafe { hist.slice(le * stride, stride) };
-                    let r: Result<ElementOut, _> = match form {
-                        Formulation::OnePoint(hg) => {
-                            let rf = one_point::OnePointRef {
-                                grad: &grad[le],
-                                gamma: &gamma[le],
-                                vol0: vol0[le],
-                                hg_scale: hgk[le],
-                            };
-                            one_point::compute_forces(l, &rf, hg.form, &xe, &ue, &ve, s, input, h, fe)
-                        }
-                        Formulation::Full { fbar } => {
-                            let rf = full::FullRef {
-                                centre_grad: &grad[le],
-                                gp_grad: &gpg[le],
-                                gp_weight: &gpw[le],
-                                vol0: vol0[le],
-                            };
-                            full::compute_forces(l, &rf, fbar, &xe, &ue, &ve, s, input, h, fe)
-                        }
-                    };
-                    match r {
-                        Ok(mut o) => {
-                            if o.dt < dt_floor {
-                                // Run-time mass scaling: dt grows with sqrt(density scale).
-                                let r = dt_floor / o.dt;
-                                acc.rescale.push((le as u32, s * r * r));
-                                o.dt = dt_floor;
-                            }
-                            if o.dt < acc.dt_min {
-                                acc.dt_min = o.dt;
-                                acc.dt_elem = elements[le];
-                            }
-                            acc.hg_stored += o.hourglass_stored;
-                            acc.hg_power += o.hourglass_power;
-                            let hg = o.hourglass_stored + o.hourglass_power * input.dt;
-                            if hg > acc.hg_peak {
-                                acc.hg_peak = hg;
-                                acc.hg_peak_elem = elements[le];
-                            }
-                            acc.bulk_power += o.bulk_power;
-                            acc.law_dissipation += o.law_dissipation;
-                            if o.failed {
-                                acc.failed.push(le as u32);
-                            }
-                            if let Some(sp) = stress_ptr {
-                                // SAFETY: one element writes one entry.
-                                unsafe { sp.slice(elements[le] as usize, 1)[0] = o.cauchy };
-                            }
-                        }
-                        Err(e) => {
-                            if acc.error.is_none() {
-                                acc.error = Some((elements[le], e.to_string()));
-                            }
-                            *fe = [[0.0; 8]; 3];
-                        }
-                    }
-                }
-                *out = acc;
-            });
+        let batch = Batch {
+            form: part.formulation,
+            group: g,
+            x_ref,
+            u,
+            v,
+            input,
+            hist,
+            stress: stress_ptr,
+        };
+        with_law!(&part.material, l => {
+            gslots
+                .par_chunks_mut(CHUNK / LANES)
+                .zip(chunks.par_iter_mut())
+                .enumerate()
+                .for_each(|(ci, (fch, out))| *out = run_chunk(l, &batch, ci, fch));
         });
+        g.chunks = chunks;
         for ch in &g.chunks {
             if let Some(e) = &ch.error {
                 return Err(e.clone());
@@ -205,8 +177,148 @@ pub fn element_loop(
     Ok(tot)
 }
 
+/// One chunk of batches, with the instruction set of [`simd_level`].
+fn run_chunk<L: Law>(l: &L, b: &Batch, ci: usize, fch: &mut [Nodal<F64x8>]) -> ChunkOut {
+    #[cfg(target_arch = "x86_64")]
+    if simd_level() == "avx512" {
+        // SAFETY: the processor has the features (checked by `simd_level`).
+        return unsafe { run_chunk_avx512(l, b, ci, fch) };
+    }
+    run_chunk_body(l, b, ci, fch)
+}
+
+/// [`run_chunk_body`] compiled for AVX-512.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f,avx512dq,avx512vl,avx512bw")]
+unsafe fn run_chunk_avx512<L: Law>(
+    l: &L,
+    b: &Batch,
+    ci: usize,
+    fch: &mut [Nodal<F64x8>],
+) -> ChunkOut {
+    run_chunk_body(l, b, ci, fch)
+}
+
+/// Lane vector of per-element values `x[le0 + lane]`, lanes past `n` repeating the last.
+#[inline(always)]
+fn lanes_of(x: &[f64], le0: usize) -> F64x8 {
+    let n = x.len();
+    F64x8::new(material::arr![LANES, |l| x[(le0 + l).min(n - 1)]])
+}
+
+#[inline(always)]
+fn run_chunk_body<L: Law>(l: &L, b: &Batch, ci: usize, fch: &mut [Nodal<F64x8>]) -> ChunkOut {
+    let g = b.group;
+    let n = g.elements.len();
+    let stride = g.history_stride;
+    let mut acc = ChunkOut {
+        dt_min: f64::INFINITY,
+        ..Default::default()
+    };
+    for (k, fe) in fch.iter_mut().enumerate() {
+        let bi = ci * (CHUNK / LANES) + k;
+        let le0 = bi * LANES;
+        let nvalid = LANES.min(n - le0);
+        let conn: [&[u32; 8]; LANES] = material::arr![LANES, |q| &g.conn[(le0 + q).min(n - 1)]];
+        // Gather into plain arrays [component][node][lane], then load whole lane vectors.
+        let mut xb = [[[0.0; LANES]; 8]; 3];
+        let mut ub = [[[0.0; LANES]; 8]; 3];
+        let mut vb = [[[0.0; LANES]; 8]; 3];
+        for a in 0..8 {
+            for (q, c) in conn.iter().enumerate() {
+                let nd = c[a] as usize;
+                let (un, vn, xr) = (b.u[nd], b.v[nd], b.x_ref[nd]);
+                for i in 0..3 {
+                    ub[i][a][q] = un[i];
+                    vb[i][a][q] = vn[i];
+                    xb[i][a][q] = xr[i] + un[i];
+                }
+            }
+        }
+        let xe: Nodal<F64x8> = material::arr![3, |i| material::arr![8, |a| F64x8::new(xb[i][a])]];
+        let ue: Nodal<F64x8> = material::arr![3, |i| material::arr![8, |a| F64x8::new(ub[i][a])]];
+        let ve: Nodal<F64x8> = material::arr![3, |i| material::arr![8, |a| F64x8::new(vb[i][a])]];
+        let s = if g.density_scale.is_empty() {
+            F64x8::splat(1.0)
+        } else {
+            lanes_of(&g.density_scale, le0)
+        };
+        // SAFETY: batch bi owns history[bi*stride..(bi+1)*stride] alone.
+        let h = unsafe { b.hist.slice(bi * stride, stride) };
+        let o: ElementOut<F64x8> = match b.form {
+            Formulation::OnePoint(hg) => {
+                let rf = one_point::OnePointRef {
+                    grad: &g.grad[bi],
+                    gamma: &g.gamma[bi],
+                    vol0: lanes_of(&g.vol0, le0),
+                    hg_scale: lanes_of(&g.hg_scale, le0),
+                };
+                one_point::compute_forces(l, &rf, hg.form, &xe, &ue, &ve, s, b.input, h, fe)
+            }
+            Formulation::Full { fbar } => {
+                let rf = full::FullRef {
+                    centre_grad: &g.grad[bi],
+                    gp_grad: &g.gp_grad[bi],
+                    gp_weight: &g.gp_weight[bi],
+                    vol0: lanes_of(&g.vol0, le0),
+                };
+                full::compute_forces(l, &rf, fbar, &xe, &ue, &ve, s, b.input, h, fe)
+            }
+        };
+        for q in 0..nvalid {
+            let le = le0 + q;
+            let eroded = !g.eroded.is_empty() && g.eroded[le];
+            let fault = o.fault.lane(q);
+            if eroded || fault != 0.0 {
+                if !eroded && acc.error.is_none() {
+                    let e = fault_error(fault, o.fault_value.lane(q), l.name());
+                    acc.error = Some((g.elements[le], e.to_string()));
+                }
+                for row in fe.iter_mut() {
+                    for x in row.iter_mut() {
+                        x.set_lane(q, 0.0);
+                    }
+                }
+                continue;
+            }
+            let mut dt = o.dt.lane(q);
+            if dt < g.dt_floor {
+                // Run-time mass scaling: dt grows with sqrt(density scale).
+                let r = g.dt_floor / dt;
+                acc.rescale.push((le as u32, s.lane(q) * r * r));
+                dt = g.dt_floor;
+            }
+            if dt < acc.dt_min {
+                acc.dt_min = dt;
+                acc.dt_elem = g.elements[le];
+            }
+            let (hs, hp) = (o.hourglass_stored.lane(q), o.hourglass_power.lane(q));
+            acc.hg_stored += hs;
+            acc.hg_power += hp;
+            let hg = hs + hp * b.input.dt;
+            if hg > acc.hg_peak {
+                acc.hg_peak = hg;
+                acc.hg_peak_elem = g.elements[le];
+            }
+            acc.bulk_power += o.bulk_power.lane(q);
+            acc.law_dissipation += o.law_dissipation.lane(q);
+            if o.failed.lane(q) {
+                acc.failed.push(le as u32);
+            }
+            if let Some(sp) = b.stress {
+                // SAFETY: one element writes one entry.
+                unsafe {
+                    sp.slice(g.elements[le] as usize, 1)[0] =
+                        material::arr![6, |c| o.cauchy[c].lane(q)]
+                };
+            }
+        }
+    }
+    acc
+}
+
 /// Gather element slots into nodal forces: f[n] = sum of its slots, in table order.
-pub fn gather(model: &Model, slots: &[Nodal], f: &mut [[f64; 3]]) {
+pub fn gather(model: &Model, slots: &[Nodal<F64x8>], f: &mut [[f64; 3]]) {
     let ptr = &model.gather_ptr;
     let idx = &model.gather_idx;
     f.par_chunks_mut(4096).enumerate().for_each(|(ci, ch)| {
@@ -215,10 +327,11 @@ pub fn gather(model: &Model, slots: &[Nodal], f: &mut [[f64; 3]]) {
             let mut s = [0.0; 3];
             for &sl in &idx[ptr[n] as usize..ptr[n + 1] as usize] {
                 let (e, a) = ((sl >> 3) as usize, (sl & 7) as usize);
-                let v = &slots[e];
-                s[0] += v[0][a];
-                s[1] += v[1][a];
-                s[2] += v[2][a];
+                let v = &slots[e / LANES];
+                let q = e % LANES;
+                s[0] += v[0][a].lane(q);
+                s[1] += v[1][a].lane(q);
+                s[2] += v[2][a].lane(q);
             }
             *fn_ = s;
         }

@@ -14,10 +14,11 @@
 //! (dt_t / (s_f L/c))^2, which raises its step to exactly dt_t; other elements are untouched.
 //! The added mass is reported per part.
 
-use crate::element::max_face_area;
+use crate::element::{max_face_area, Nodal};
 use crate::element::{surface_mode_factor, Formulation, HourglassForm, HourglassModulus};
 use crate::hex::{element_geometry, hourglass_gamma};
 use crate::mesh::Mesh;
+use material::real::{F64x8, Real, LANES};
 use material::Material;
 use std::fmt;
 
@@ -135,26 +136,29 @@ pub struct Group {
     /// Connectivity.
     pub conn: Vec<[u32; 8]>,
     /// Mean gradient b_a = 1/V int grad N_a dV, [component][node] (F of one-point elements,
-    /// F0 of F-bar elements).
-    pub grad: Vec<[[f64; 8]; 3]>,
+    /// F0 of F-bar elements), per batch of [`LANES`] elements (lane = element of the batch).
+    pub grad: Vec<Nodal<F64x8>>,
     /// Reference volumes (m^3).
     pub vol0: Vec<f64>,
-    /// Hourglass vectors (one-point only).
-    pub gamma: Vec<[[f64; 8]; 4]>,
+    /// Hourglass vectors (one-point only), per batch.
+    pub gamma: Vec<[[F64x8; 8]; 4]>,
     /// Hourglass scale per element (one-point only): a_s (N/m) for the stiffness form,
     /// Q rho0 V0^(2/3) / 4 (kg/m) for the viscous form.
     pub hg_scale: Vec<f64>,
-    /// Gauss-point gradients (full only).
-    pub gp_grad: Vec<[[[f64; 8]; 3]; 8]>,
-    /// Gauss-point weights (full only).
-    pub gp_weight: Vec<[f64; 8]>,
+    /// Gauss-point gradients (full only), per batch.
+    pub gp_grad: Vec<[Nodal<F64x8>; 8]>,
+    /// Gauss-point weights (full only), per batch.
+    pub gp_weight: Vec<[F64x8; 8]>,
     /// History values per element (history_len * n_ip).
     pub history_stride: usize,
-    /// History buffer (empty for a law without history).
-    pub history: Vec<f64>,
+    /// History buffer (empty for a law without history): `history_stride` lane vectors per
+    /// batch, value `k` of integration point `ip` at `batch * stride + ip * history_len + k`, so
+    /// each history variable of a batch is contiguous over its elements (struct of arrays).
+    pub history: Vec<F64x8>,
     /// Density scale factors from mass scaling (empty if none).
     pub density_scale: Vec<f64>,
-    /// Offset of this group's elements in the element-force slot buffer.
+    /// Offset of this group's elements in the element-force slot buffer (a multiple of
+    /// [`LANES`]: the slots of a batch are one lane vector per force component and node).
     pub slot_offset: usize,
     /// Scratch: per-chunk partial results.
     pub chunks: Vec<ChunkOut>,
@@ -171,9 +175,48 @@ pub struct Group {
     pub lumped: Vec<[f64; 8]>,
 }
 
-/// Elements per parallel chunk. Fixed, so partial sums are formed in the same order for any
-/// thread count (bitwise determinism).
+/// Elements per parallel chunk (a multiple of [`LANES`]). Fixed, so partial sums are formed in
+/// the same order for any thread count (bitwise determinism).
 pub const CHUNK: usize = 512;
+
+impl Group {
+    /// Number of batches of [`LANES`] elements (the last one padded with copies of the group's
+    /// last element, whose results are discarded).
+    pub fn batches(&self) -> usize {
+        self.elements.len().div_ceil(LANES)
+    }
+
+    /// History value `k` of integration point `ip` of group-local element `le`.
+    pub fn history_value(&self, le: usize, ip: usize, k: usize, history_len: usize) -> f64 {
+        self.history[(le / LANES) * self.history_stride + ip * history_len + k].lane(le % LANES)
+    }
+
+    /// History value `k` of every integration point of every element (padding excluded).
+    pub fn history_values(&self, k: usize, history_len: usize) -> Vec<f64> {
+        let n_ip = self.history_stride / history_len.max(1);
+        (0..self.elements.len())
+            .flat_map(|le| (0..n_ip).map(move |ip| (le, ip)))
+            .map(|(le, ip)| self.history_value(le, ip, k, history_len))
+            .collect()
+    }
+}
+
+/// Lane vectors of per-element data, batch by batch; lanes past the end repeat the last element.
+fn batched<T: Copy, U>(aos: &[T], f: impl Fn(&[&T; LANES]) -> U) -> Vec<U> {
+    let n = aos.len();
+    (0..n.div_ceil(LANES))
+        .map(|b| {
+            let items: [&T; LANES] = std::array::from_fn(|l| &aos[(b * LANES + l).min(n - 1)]);
+            f(&items)
+        })
+        .collect()
+}
+
+/// One lane vector from eight per-element values.
+#[inline]
+fn lanes(f: impl Fn(usize) -> f64) -> F64x8 {
+    F64x8::new(std::array::from_fn(f))
+}
 
 /// Mass-scaling request.
 #[derive(Clone, Copy, Debug)]
@@ -411,14 +454,14 @@ impl Model {
                 part: pi,
                 elements: elems.clone(),
                 conn: Vec::with_capacity(n),
-                grad: Vec::with_capacity(n),
+                grad: Vec::new(),
                 vol0: Vec::with_capacity(n),
                 gamma: Vec::new(),
                 hg_scale: Vec::new(),
                 gp_grad: Vec::new(),
                 gp_weight: Vec::new(),
                 history_stride: stride,
-                history: vec![0.0; stride * n],
+                history: vec![F64x8::splat(0.0); stride * n.div_ceil(LANES)],
                 density_scale: Vec::new(),
                 slot_offset,
                 chunks: vec![ChunkOut::default(); n.div_ceil(CHUNK)],
@@ -428,6 +471,10 @@ impl Model {
                 lumped: Vec::new(),
             };
             let mut scale = Vec::with_capacity(n);
+            let mut grad: Vec<Nodal> = Vec::with_capacity(n);
+            let mut gamma: Vec<[[f64; 8]; 4]> = Vec::new();
+            let mut gp_grad: Vec<[Nodal; 8]> = Vec::new();
+            let mut gp_weight: Vec<[f64; 8]> = Vec::new();
             let lambda2mu = rho * c0 * c0;
             g.dt_kappa = kappa;
             if let Some(t) = fixed_target {
@@ -456,8 +503,8 @@ impl Model {
                 g.vol0.push(geo.volume);
                 match form {
                     Formulation::OnePoint(hg) => {
-                        g.grad.push(geo.mean_grad);
-                        g.gamma.push(hourglass_gamma(&x, &geo.mean_grad));
+                        grad.push(geo.mean_grad);
+                        gamma.push(hourglass_gamma(&x, &geo.mean_grad));
                         if hg.form == HourglassForm::Stiffness {
                             let mut bb = 0.0;
                             for i in 0..3 {
@@ -480,9 +527,9 @@ impl Model {
                         }
                     }
                     Formulation::Full { .. } => {
-                        g.grad.push(geo.mean_grad);
-                        g.gp_grad.push(geo.gp_grad);
-                        g.gp_weight.push(geo.gp_weight);
+                        grad.push(geo.mean_grad);
+                        gp_grad.push(geo.gp_grad);
+                        gp_weight.push(geo.gp_weight);
                     }
                 }
                 let dte = g.dt_kappa * initial_element_dt(&x, geo.volume, c0);
@@ -512,15 +559,30 @@ impl Model {
             if mass_scaling.is_some() {
                 g.density_scale = scale;
             }
+            let nodal = |e: &[&Nodal; LANES]| -> Nodal<F64x8> {
+                std::array::from_fn(|i| std::array::from_fn(|a| lanes(|l| e[l][i][a])))
+            };
+            g.grad = batched(&grad, nodal);
+            g.gamma = batched(&gamma, |e| {
+                std::array::from_fn(|k| std::array::from_fn(|a| lanes(|l| e[l][k][a])))
+            });
+            g.gp_grad = batched(&gp_grad, |e| {
+                std::array::from_fn(|gp| {
+                    std::array::from_fn(|i| std::array::from_fn(|a| lanes(|l| e[l][gp][i][a])))
+                })
+            });
+            g.gp_weight = batched(&gp_weight, |e| {
+                std::array::from_fn(|gp| lanes(|l| e[l][gp]))
+            });
             if stride > 0 {
                 let hl = law.history_len();
-                material::with_law!(law, l => {
-                    for chunk in g.history.chunks_mut(hl) {
-                        material::Law::init_history(l, chunk);
-                    }
-                });
+                let mut h0 = vec![0.0; hl];
+                material::with_law!(law, l => material::Law::init_history(l, &mut h0));
+                for (k, h) in g.history.iter_mut().enumerate() {
+                    *h = F64x8::splat(h0[k % stride % hl]);
+                }
             }
-            slot_offset += n;
+            slot_offset += n.div_ceil(LANES) * LANES;
             groups.push(g);
         }
         if let Some(ms) = mass_scaling {
@@ -587,6 +649,12 @@ impl Model {
                 _ => None,
             },
         })
+    }
+
+    /// A zeroed element-force buffer for [`crate::forces::element_loop`]: one batch slot (a lane
+    /// vector per force component and node) per [`LANES`] slots.
+    pub fn slot_buffer(&self) -> Vec<Nodal<F64x8>> {
+        vec![[[F64x8::zero(); 8]; 3]; self.n_slots / LANES]
     }
 
     /// Total physical mass (kg).

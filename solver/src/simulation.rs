@@ -234,7 +234,7 @@ pub struct Simulation {
     pub reaction: Vec<[f64; 3]>,
     /// Cauchy stress per element at the last output step (Pa), if requested.
     pub stress: Option<Vec<[f64; 6]>>,
-    slots: Vec<crate::element::Nodal>,
+    slots: Vec<crate::element::Nodal<material::real::F64x8>>,
     dof_code: Vec<u32>,
     prescribed: Vec<Prescribed>,
     loads: Vec<NodalLoad>,
@@ -339,7 +339,7 @@ impl Simulation {
                 .map(|&m| [m * g[0], m * g[1], m * g[2]])
                 .collect()
         });
-        let n_slots = model.n_slots;
+        let slots = model.slot_buffer();
         let ne = model.mesh.elements.len();
         let mut v = initial_velocity.unwrap_or_else(|| vec![[0.0; 3]; nn]);
         if v.len() != nn {
@@ -386,7 +386,7 @@ impl Simulation {
             } else {
                 None
             },
-            slots: vec![[[0.0; 8]; 3]; n_slots],
+            slots,
             dof_code,
             prescribed,
             loads,

@@ -64,15 +64,16 @@ pub fn check(path: &Path) -> Result<(), String> {
         steps * mesh.elements.len() as f64,
         scene.end_time * 1e3
     );
-    let hist: usize = m.groups.iter().map(|g| g.history.len()).sum();
+    let hist: usize = m.groups.iter().map(|g| g.history.len() * 8).sum();
     let ref_data: usize = m
         .groups
         .iter()
         .map(|g| {
-            g.conn.len() * (8 * 4 + 24 * 8 + 8)
-                + g.gamma.len() * 32 * 8
-                + g.gp_grad.len() * 192 * 8
-                + g.gp_weight.len() * 64
+            g.conn.len() * (8 * 4 + 8)
+                + std::mem::size_of_val(g.grad.as_slice())
+                + std::mem::size_of_val(g.gamma.as_slice())
+                + std::mem::size_of_val(g.gp_grad.as_slice())
+                + std::mem::size_of_val(g.gp_weight.as_slice())
                 + g.density_scale.len() * 8
         })
         .sum();

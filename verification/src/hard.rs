@@ -296,14 +296,12 @@ pub fn ribs_bending() -> Result<(HardRun, f64), String> {
     let mut s = sim(m, mat, FULL_FBAR, c)?;
     let r = run_explicit(&mut s, 0.025, |_| {});
     let k = names.iter().position(|n| n == "eps_p");
-    let stride = names.len();
+    let hl = names.len();
     let eps_max = match k {
-        Some(k) if stride > 0 => s.model.groups[0]
-            .history
-            .iter()
-            .skip(k)
-            .step_by(stride)
-            .fold(0.0f64, |a, &b| a.max(b)),
+        Some(k) if hl > 0 => s.model.groups[0]
+            .history_values(k, hl)
+            .into_iter()
+            .fold(0.0f64, f64::max),
         _ => f64::NAN,
     };
     Ok((r, eps_max))

@@ -14,21 +14,23 @@
 //! Without F-bar: f_a = sum_gp w detJ P g_a.
 
 use super::{
-    add_nodal_forces, bulk_pressure, cofactor, critical_step, deformation_gradient, gradient_rate,
-    max_face_area, sym6, ElementOut, Nodal, StepInput,
+    add_nodal_forces, all_finite, bulk_pressure, critical_step, deformation_gradient,
+    gradient_rate, max_face_area, sym6, ElementOut, Nodal, StepInput, FAULT_DISTORTED, FAULT_FORCE,
 };
-use material::{Law, LawError, Mat3};
+use material::real::Real;
+use material::tensor::{cofactor, ddot, det, mul, mul_bt, scale, M3};
+use material::Law;
 
-/// Reference data of one fully integrated element.
-pub struct FullRef<'a> {
+/// Reference data of one fully integrated element (or of one batch, one element per lane).
+pub struct FullRef<'a, R: Real = f64> {
     /// Mean gradient [component][node] (1/m).
-    pub centre_grad: &'a Nodal,
+    pub centre_grad: &'a Nodal<R>,
     /// Gauss-point gradients.
-    pub gp_grad: &'a [Nodal; 8],
+    pub gp_grad: &'a [Nodal<R>; 8],
     /// Gauss weights times det J (m^3).
-    pub gp_weight: &'a [f64; 8],
+    pub gp_weight: &'a [R; 8],
     /// Reference volume (m^3).
-    pub vol0: f64,
+    pub vol0: R,
 }
 
 /// Smallest Gauss-point volume ratio det F a fully integrated element may reach before the run
@@ -41,110 +43,122 @@ pub struct FullRef<'a> {
 /// loss is never physical there.
 pub const MIN_GAUSS_VOLUME_RATIO: f64 = 0.05;
 
-/// Internal forces of one element; history holds 8 consecutive integration-point blocks.
+/// Internal forces of one element, or of a batch (one element per lane); history holds 8
+/// consecutive integration-point blocks. Faults are reported per lane in the output.
 #[allow(clippy::too_many_arguments)]
-#[inline]
-pub fn compute_forces<L: Law>(
+#[inline(always)]
+pub fn compute_forces<R: Real, L: Law>(
     law: &L,
-    r: &FullRef,
+    r: &FullRef<R>,
     fbar: bool,
-    x: &Nodal,
-    u: &Nodal,
-    v: &Nodal,
-    density_scale: f64,
+    x: &Nodal<R>,
+    u: &Nodal<R>,
+    v: &Nodal<R>,
+    density_scale: R,
     input: &StepInput,
-    history: &mut [f64],
-    fe: &mut Nodal,
-) -> Result<ElementOut, LawError> {
+    history: &mut [R],
+    fe: &mut Nodal<R>,
+) -> ElementOut<R> {
     let hl = law.history_len();
+    let one = R::splat(1.0);
     let f0 = deformation_gradient(u, r.centre_grad);
-    let j0 = f0.determinant();
-    if !(j0 > 0.0) {
-        return Err(LawError::NonPositiveJacobian(j0));
-    }
-    let f0it = f0
-        .try_inverse()
-        .ok_or(LawError::NotFinite("F0"))?
-        .transpose();
+    let j0 = det(&f0);
+    let mut out = ElementOut::zero();
+    out.fault_where(
+        !j0.gt(R::zero()),
+        R::splat(material::law::FAULT_JACOBIAN),
+        j0,
+    );
+    // F0^-T = cof(F0) / J0.
+    let f0it = scale(&cofactor(&f0), one / j0);
     let rho0 = law.density();
     let vol = j0 * r.vol0;
     let l = vol / max_face_area(x);
-    let mut out = ElementOut::default();
-    let mut q = 0.0;
-    let mut qterm = 0.0;
-    let mut cmax: f64 = 0.0;
+    let mut cmax = R::zero();
     // Bulk viscosity from the centre rate of volume change.
-    let mut trd = 0.0;
+    let mut trd = R::zero();
     if input.bulk.is_some() {
-        trd = gradient_rate(v, r.centre_grad).component_mul(&f0it).sum();
+        trd = ddot(&gradient_rate(v, r.centre_grad), &f0it);
     }
-    *fe = [[0.0; 8]; 3];
-    let mut sig_acc = Mat3::zeros();
-    let mut vol_acc = 0.0;
+    *fe = [[R::zero(); 8]; 3];
+    let mut sig_acc: M3<R> = [[R::zero(); 3]; 3];
+    let mut vol_acc = R::zero();
     for gp in 0..8 {
         let g = &r.gp_grad[gp];
         let w = r.gp_weight[gp];
         let f = deformation_gradient(u, g);
-        let j = f.determinant();
-        if !(j > MIN_GAUSS_VOLUME_RATIO) {
-            return Err(if j > 0.0 {
-                LawError::ExcessiveDistortion(j, MIN_GAUSS_VOLUME_RATIO)
-            } else {
-                LawError::NonPositiveJacobian(j)
-            });
-        }
+        let j = det(&f);
+        out.fault_where(
+            !j.gt(R::splat(MIN_GAUSS_VOLUME_RATIO)),
+            R::splat(FAULT_DISTORTED),
+            j,
+        );
         let h = &mut history[gp * hl..(gp + 1) * hl];
-        let fit = cofactor(&f) / j;
+        let fit = scale(&cofactor(&f), one / j);
         if fbar {
             let rr = (j0 / j).cbrt();
-            let fb = f * rr;
-            let resp = law.evaluate(&fb, input.dt, h)?;
+            let fb = scale(&f, rr);
+            let resp = law.stress(&fb, input.dt, h);
+            out.fault_where(resp.fault.ne(R::zero()), resp.fault, resp.fault_value);
             cmax = cmax.max(resp.wave_speed);
             out.law_dissipation += resp.dissipation * w;
-            out.failed |= resp.failed;
-            let pb = fb * resp.pk2;
-            let pf = pb.component_mul(&f).sum() / 3.0;
-            add_nodal_forces(fe, &pb, g, w * rr);
-            add_nodal_forces(fe, &(f0it * pf), r.centre_grad, w * rr);
-            add_nodal_forces(fe, &(fit * (-pf)), g, w * rr);
+            out.failed = out.failed | resp.failed;
+            let pb = mul(&fb, &resp.pk2);
+            let pf = ddot(&pb, &f) * (1.0 / 3.0);
+            let wr = w * rr;
+            add_nodal_forces(fe, &pb, g, wr);
+            add_nodal_forces(fe, &scale(&f0it, pf), r.centre_grad, wr);
+            add_nodal_forces(fe, &scale(&fit, -pf), g, wr);
             if input.want_stress {
-                sig_acc += fb * resp.pk2 * fb.transpose() * (w / j0 * j0);
+                let t = mul_bt(&pb, &fb);
+                let k = w / j0 * j0;
+                for i in 0..3 {
+                    for c in 0..3 {
+                        sig_acc[i][c] += t[i][c] * k;
+                    }
+                }
                 vol_acc += w * j0;
             }
         } else {
-            let resp = law.evaluate(&f, input.dt, h)?;
+            let resp = law.stress(&f, input.dt, h);
+            out.fault_where(resp.fault.ne(R::zero()), resp.fault, resp.fault_value);
             cmax = cmax.max(resp.wave_speed);
             out.law_dissipation += resp.dissipation * w;
-            out.failed |= resp.failed;
-            let p = f * resp.pk2;
+            out.failed = out.failed | resp.failed;
+            let p = mul(&f, &resp.pk2);
             add_nodal_forces(fe, &p, g, w);
             if input.want_stress {
-                sig_acc += f * resp.pk2 * f.transpose() * (w / j * j);
+                let t = mul_bt(&p, &f);
+                let k = w / j * j;
+                for i in 0..3 {
+                    for c in 0..3 {
+                        sig_acc[i][c] += t[i][c] * k;
+                    }
+                }
                 vol_acc += w * j;
             }
         }
     }
+    let mut q = R::zero();
+    let mut qterm = R::zero();
     if let Some(bv) = input.bulk.as_ref() {
-        let (qq, qt) = bulk_pressure(bv, trd, rho0 / j0, l, cmax);
+        let (qq, qt) = bulk_pressure(bv, trd, R::splat(rho0) / j0, l, cmax);
         q = qq;
         qterm = qt;
-        if q != 0.0 {
-            // Pressure -q on the whole element, through the centre gradient.
-            add_nodal_forces(fe, &(f0it * (-q * j0)), r.centre_grad, r.vol0);
-            out.bulk_power = q * (-trd) * vol;
-        }
+        // Pressure -q on the whole element, through the centre gradient (zero where it expands).
+        add_nodal_forces(fe, &scale(&f0it, -q * j0), r.centre_grad, r.vol0);
+        out.bulk_power = q * (-trd) * vol;
     }
     out.dt = critical_step(l, cmax / density_scale.sqrt(), qterm);
     if input.want_stress {
         // Volume average of Cauchy stress: sum sigma_gp J_gp w / sum J_gp w, where sigma = tau / J.
-        let mut s = sig_acc / vol_acc;
-        s[(0, 0)] -= q;
-        s[(1, 1)] -= q;
-        s[(2, 2)] -= q;
+        let mut s = scale(&sig_acc, one / vol_acc);
+        for i in 0..3 {
+            s[i][i] -= q;
+        }
         out.cauchy = sym6(&s);
     }
-    if !out.dt.is_finite() || !fe.iter().all(|r| r.iter().all(|x| x.is_finite())) {
-        return Err(LawError::NotFinite("element force"));
-    }
-    Ok(out)
+    let ok = out.dt.is_finite() & all_finite(fe);
+    out.fault_where(!ok, R::splat(FAULT_FORCE), out.dt);
+    out
 }

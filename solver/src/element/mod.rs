@@ -19,7 +19,9 @@
 pub mod full;
 pub mod one_point;
 
-use material::Mat3;
+use material::real::{Mask, Real};
+use material::tensor::M3;
+use material::LawError;
 
 /// Bulk-viscosity coefficients (quadratic C0, linear C1).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -145,97 +147,112 @@ pub struct StepInput {
     pub want_stress: bool,
 }
 
-/// What one element returns besides its nodal forces.
-#[derive(Clone, Copy, Debug, Default)]
-pub struct ElementOut {
+/// What one element (or one batch of elements, one per lane) returns besides its nodal forces.
+#[derive(Clone, Copy, Debug)]
+pub struct ElementOut<R: Real = f64> {
     /// Critical time step of the element (s).
-    pub dt: f64,
+    pub dt: R,
     /// Hourglass energy: stored (stiffness form, total) (J).
-    pub hourglass_stored: f64,
+    pub hourglass_stored: R,
     /// Hourglass dissipation power (viscous form) (W).
-    pub hourglass_power: f64,
+    pub hourglass_power: R,
     /// Bulk-viscous dissipation power (W).
-    pub bulk_power: f64,
+    pub bulk_power: R,
     /// Law dissipation over the step (J).
-    pub law_dissipation: f64,
+    pub law_dissipation: R,
     /// Volume-averaged Cauchy stress, if requested (Pa), xx yy zz xy yz zx.
-    pub cauchy: [f64; 6],
+    pub cauchy: [R; 6],
     /// An integration point reached its failure criterion.
-    pub failed: bool,
+    pub failed: R::Mask,
+    /// 0 where the element was evaluated, else a law fault code
+    /// ([`material::law::FAULT_JACOBIAN`], ...) or [`FAULT_DISTORTED`] / [`FAULT_FORCE`].
+    pub fault: R,
+    /// The quantity the fault names (det F).
+    pub fault_value: R,
+}
+
+impl<R: Real> ElementOut<R> {
+    /// All zero, no fault.
+    #[inline(always)]
+    pub fn zero() -> Self {
+        let z = R::zero();
+        ElementOut {
+            dt: z,
+            hourglass_stored: z,
+            hourglass_power: z,
+            bulk_power: z,
+            law_dissipation: z,
+            cauchy: [z; 6],
+            failed: R::Mask::splat(false),
+            fault: z,
+            fault_value: z,
+        }
+    }
+
+    /// Record a fault where `m` is set and no earlier fault is.
+    #[inline(always)]
+    pub fn fault_where(&mut self, m: R::Mask, code: R, value: R) {
+        let m = m & !self.fault.ne(R::zero());
+        self.fault = R::select(m, code, self.fault);
+        self.fault_value = R::select(m, value, self.fault_value);
+    }
+}
+
+/// Element fault code: a Gauss point's volume ratio fell below [`full::MIN_GAUSS_VOLUME_RATIO`].
+pub const FAULT_DISTORTED: f64 = 10.0;
+/// Element fault code: the step or a nodal force is not finite.
+pub const FAULT_FORCE: f64 = 11.0;
+
+/// The error an element fault code stands for (`what`: the law's name).
+pub fn fault_error(code: f64, value: f64, what: &'static str) -> LawError {
+    if code == FAULT_DISTORTED {
+        if value > 0.0 {
+            LawError::ExcessiveDistortion(value, full::MIN_GAUSS_VOLUME_RATIO)
+        } else {
+            LawError::NonPositiveJacobian(value)
+        }
+    } else if code == FAULT_FORCE {
+        LawError::NotFinite("element force")
+    } else {
+        material::law::fault_error(code, value, what)
+    }
 }
 
 /// Eight nodal values of one component.
-pub type Vec8 = [f64; 8];
+pub type Vec8<R = f64> = [R; 8];
 /// Nodal vectors of one element in component-major order: `v[i][a]` is component i of node a.
-/// Kernels work on this layout so that the loops over the eight nodes vectorise.
-pub type Nodal = [Vec8; 3];
+/// Kernels work on this layout so that the loops over the eight nodes vectorise; in a batch each
+/// entry holds the lanes of eight elements.
+pub type Nodal<R = f64> = [Vec8<R>; 3];
 
 /// sum_a x_a y_a, summed pairwise in a fixed order (so it vectorises and stays deterministic).
 #[inline(always)]
-pub fn dot8(x: &Vec8, y: &Vec8) -> f64 {
-    let mut t = [0.0; 4];
-    for k in 0..4 {
-        t[k] = x[k] * y[k] + x[k + 4] * y[k + 4];
-    }
+pub fn dot8<R: Real>(x: &Vec8<R>, y: &Vec8<R>) -> R {
+    let t: [R; 4] = material::arr![4, |k| x[k] * y[k] + x[k + 4] * y[k + 4]];
     (t[0] + t[1]) + (t[2] + t[3])
 }
 
 /// F = I + sum_a u_a (x) grad N_a.
 #[inline(always)]
-pub fn deformation_gradient(u: &Nodal, g: &Nodal) -> Mat3 {
-    Mat3::new(
-        1.0 + dot8(&u[0], &g[0]),
-        dot8(&u[0], &g[1]),
-        dot8(&u[0], &g[2]),
-        dot8(&u[1], &g[0]),
-        1.0 + dot8(&u[1], &g[1]),
-        dot8(&u[1], &g[2]),
-        dot8(&u[2], &g[0]),
-        dot8(&u[2], &g[1]),
-        1.0 + dot8(&u[2], &g[2]),
-    )
+pub fn deformation_gradient<R: Real>(u: &Nodal<R>, g: &Nodal<R>) -> M3<R> {
+    let mut f = gradient_rate(u, g);
+    for i in 0..3 {
+        f[i][i] += R::splat(1.0);
+    }
+    f
 }
 
 /// Rate of F: sum_a v_a (x) grad N_a.
 #[inline(always)]
-pub fn gradient_rate(v: &Nodal, g: &Nodal) -> Mat3 {
-    Mat3::new(
-        dot8(&v[0], &g[0]),
-        dot8(&v[0], &g[1]),
-        dot8(&v[0], &g[2]),
-        dot8(&v[1], &g[0]),
-        dot8(&v[1], &g[1]),
-        dot8(&v[1], &g[2]),
-        dot8(&v[2], &g[0]),
-        dot8(&v[2], &g[1]),
-        dot8(&v[2], &g[2]),
-    )
-}
-
-/// Cofactor matrix cof F = det(F) F^-T, without a division.
-#[inline(always)]
-pub fn cofactor(f: &Mat3) -> Mat3 {
-    let (a, b, c) = (f[(0, 0)], f[(0, 1)], f[(0, 2)]);
-    let (d, e, g) = (f[(1, 0)], f[(1, 1)], f[(1, 2)]);
-    let (h, i, k) = (f[(2, 0)], f[(2, 1)], f[(2, 2)]);
-    Mat3::new(
-        e * k - g * i,
-        g * h - d * k,
-        d * i - e * h,
-        c * i - b * k,
-        a * k - c * h,
-        b * h - a * i,
-        b * g - c * e,
-        c * d - a * g,
-        a * e - b * d,
-    )
+pub fn gradient_rate<R: Real>(v: &Nodal<R>, g: &Nodal<R>) -> M3<R> {
+    material::arr![3, |i| material::arr![3, |j| dot8(&v[i], &g[j])]]
 }
 
 /// fe_a += w * P grad N_a.
 #[inline(always)]
-pub fn add_nodal_forces(fe: &mut Nodal, p: &Mat3, g: &Nodal, w: f64) {
+pub fn add_nodal_forces<R: Real>(fe: &mut Nodal<R>, p: &M3<R>, g: &Nodal<R>, w: R) {
     for i in 0..3 {
-        let (p0, p1, p2) = (w * p[(i, 0)], w * p[(i, 1)], w * p[(i, 2)]);
+        let (p0, p1, p2) = (w * p[i][0], w * p[i][1], w * p[i][2]);
         for a in 0..8 {
             fe[i][a] += p0 * g[0][a] + p1 * g[1][a] + p2 * g[2][a];
         }
@@ -245,19 +262,11 @@ pub fn add_nodal_forces(fe: &mut Nodal, p: &Mat3, g: &Nodal, w: f64) {
 /// Largest face area of an element (m^2), from its current coordinates: each face's area is
 /// half the norm of the cross product of its diagonals (exact for planar quads).
 #[inline(always)]
-pub fn max_face_area(x: &Nodal) -> f64 {
-    let mut amax: f64 = 0.0;
+pub fn max_face_area<R: Real>(x: &Nodal<R>) -> R {
+    let mut amax = R::zero();
     for f in crate::mesh::FACES.iter() {
-        let d1 = [
-            x[0][f[2]] - x[0][f[0]],
-            x[1][f[2]] - x[1][f[0]],
-            x[2][f[2]] - x[2][f[0]],
-        ];
-        let d2 = [
-            x[0][f[3]] - x[0][f[1]],
-            x[1][f[3]] - x[1][f[1]],
-            x[2][f[3]] - x[2][f[1]],
-        ];
+        let d1: [R; 3] = material::arr![3, |i| x[i][f[2]] - x[i][f[0]]];
+        let d2: [R; 3] = material::arr![3, |i| x[i][f[3]] - x[i][f[1]]];
         let c = [
             d1[1] * d2[2] - d1[2] * d2[1],
             d1[2] * d2[0] - d1[0] * d2[2],
@@ -265,32 +274,41 @@ pub fn max_face_area(x: &Nodal) -> f64 {
         ];
         amax = amax.max(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]);
     }
-    0.5 * amax.sqrt()
+    amax.sqrt() * 0.5
 }
 
 /// Symmetric 3x3 to Voigt-like (xx yy zz xy yz zx).
-#[inline]
-pub fn sym6(m: &Mat3) -> [f64; 6] {
-    [
-        m[(0, 0)],
-        m[(1, 1)],
-        m[(2, 2)],
-        m[(0, 1)],
-        m[(1, 2)],
-        m[(2, 0)],
-    ]
+#[inline(always)]
+pub fn sym6<R: Real>(m: &M3<R>) -> [R; 6] {
+    [m[0][0], m[1][1], m[2][2], m[0][1], m[1][2], m[2][0]]
 }
 
-/// Bulk viscous pressure q (Pa) and the Q term of the time-step formula.
-/// `trd` = tr D (1/s), `rho` current density, `l` characteristic length, `c` wave speed.
+/// Bulk viscous pressure q (Pa) and the Q term of the time-step formula, zero where the element
+/// expands. `trd` = tr D (1/s), `rho` current density, `l` characteristic length, `c` wave speed.
 #[inline(always)]
-pub fn bulk_pressure(bv: &BulkViscosity, trd: f64, rho: f64, l: f64, c: f64) -> (f64, f64) {
-    if trd < 0.0 {
-        let q = rho * l * (bv.quadratic * l * trd * trd - bv.linear * c * trd);
-        (q, bv.linear * c + bv.quadratic * l * (-trd))
-    } else {
-        (0.0, 0.0)
+pub fn bulk_pressure<R: Real>(bv: &BulkViscosity, trd: R, rho: R, l: R, c: R) -> (R, R) {
+    let comp = trd.lt(R::zero());
+    let q = rho * l * (l * bv.quadratic * trd * trd - c * bv.linear * trd);
+    let qt = c * bv.linear + l * bv.quadratic * (-trd);
+    (
+        R::select(comp, q, R::zero()),
+        R::select(comp, qt, R::zero()),
+    )
+}
+
+/// Whether every entry of the nodal forces is finite.
+#[inline(always)]
+pub fn all_finite<R: Real>(fe: &Nodal<R>) -> R::Mask {
+    let mut m = R::Mask::splat(true);
+    for row in fe {
+        let mut s = R::zero();
+        for x in row {
+            s += *x * 0.0;
+        }
+        // x * 0 is 0 for finite x and NaN otherwise; one test per row.
+        m = m & s.is_finite();
     }
+    m
 }
 
 /// Constant of [`surface_mode_factor`], fitted below every measured curve.
@@ -333,6 +351,6 @@ pub fn surface_mode_factor(p_wave_modulus: f64, shear_modulus: f64) -> f64 {
 
 /// Critical step L / (Q + sqrt(Q^2 + c^2)).
 #[inline(always)]
-pub fn critical_step(l: f64, c: f64, qterm: f64) -> f64 {
+pub fn critical_step<R: Real>(l: R, c: R, qterm: R) -> R {
     l / (qterm + (qterm * qterm + c * c).sqrt())
 }

@@ -5,77 +5,84 @@
 //! qdot_ialpha = sum_a v_ia gamma_alpha,a (FB 1981 eq. 32).
 
 use super::{
-    add_nodal_forces, bulk_pressure, cofactor, critical_step, deformation_gradient, dot8,
-    gradient_rate, max_face_area, sym6, ElementOut, HourglassForm, Nodal, StepInput,
+    add_nodal_forces, all_finite, bulk_pressure, critical_step, deformation_gradient, dot8,
+    gradient_rate, max_face_area, sym6, ElementOut, HourglassForm, Nodal, StepInput, FAULT_FORCE,
 };
-use material::{Law, LawError};
+use material::real::Real;
+use material::tensor::{cofactor, ddot, det, mul, mul_bt, scale};
+use material::Law;
 
-/// Reference data of one one-point element.
-pub struct OnePointRef<'a> {
+/// Reference data of one one-point element (or of one batch, one element per lane).
+pub struct OnePointRef<'a, R: Real = f64> {
     /// Mean gradient [component][node] (1/m).
-    pub grad: &'a Nodal,
+    pub grad: &'a Nodal<R>,
     /// Hourglass shape vectors.
-    pub gamma: &'a [[f64; 8]; 4],
+    pub gamma: &'a [[R; 8]; 4],
     /// Reference volume (m^3).
-    pub vol0: f64,
+    pub vol0: R,
     /// Hourglass scale: a_s (N/m) for the stiffness form; Q rho0 V0^(2/3) / 4 (kg/m) for the
     /// viscous form, to be multiplied by the wave speed.
-    pub hg_scale: f64,
+    pub hg_scale: R,
 }
 
-/// Internal forces of one element. `x` current coordinates, `u` displacements, `v` velocities
-/// (at the previous half step), `density_scale` the mass-scaling factor of the element (>= 1).
+/// Internal forces of one element, or of a batch of elements (one per lane). `x` current
+/// coordinates, `u` displacements, `v` velocities (at the previous half step), `density_scale`
+/// the mass-scaling factor of the element (>= 1). Faults are reported per lane in the output.
 #[allow(clippy::too_many_arguments)]
-#[inline]
-pub fn compute_forces<L: Law>(
+#[inline(always)]
+pub fn compute_forces<R: Real, L: Law>(
     law: &L,
-    r: &OnePointRef,
+    r: &OnePointRef<R>,
     hg_form: HourglassForm,
-    x: &Nodal,
-    u: &Nodal,
-    v: &Nodal,
-    density_scale: f64,
+    x: &Nodal<R>,
+    u: &Nodal<R>,
+    v: &Nodal<R>,
+    density_scale: R,
     input: &StepInput,
-    history: &mut [f64],
-    fe: &mut Nodal,
-) -> Result<ElementOut, LawError> {
+    history: &mut [R],
+    fe: &mut Nodal<R>,
+) -> ElementOut<R> {
     let f = deformation_gradient(u, r.grad);
-    let resp = law.evaluate(&f, input.dt, history)?;
-    let j = f.determinant();
-    let mut p = f * resp.pk2;
+    let resp = law.stress(&f, input.dt, history);
+    let j = det(&f);
+    let mut p = mul(&f, &resp.pk2);
     let rho0 = law.density();
-    let c = resp.wave_speed / density_scale.sqrt();
+    let sqrt_scale = density_scale.sqrt();
+    let c = resp.wave_speed / sqrt_scale;
     let vol = j * r.vol0;
     let l = vol / max_face_area(x);
-    let mut out = ElementOut {
-        law_dissipation: resp.dissipation * r.vol0,
-        failed: resp.failed,
-        ..Default::default()
-    };
-    let mut qterm = 0.0;
-    let mut q = 0.0;
+    let mut out = ElementOut::zero();
+    out.law_dissipation = resp.dissipation * r.vol0;
+    out.failed = resp.failed;
+    out.fault = resp.fault;
+    out.fault_value = resp.fault_value;
+    let mut qterm = R::zero();
+    let mut q = R::zero();
     if let Some(bv) = input.bulk.as_ref() {
         // tr D = Fdot : F^-T = Fdot : cof(F) / J.
         let cof = cofactor(&f);
-        let trd = gradient_rate(v, r.grad).component_mul(&cof).sum() / j;
-        let (qq, qt) = bulk_pressure(bv, trd, rho0 / j, l, resp.wave_speed);
+        let trd = ddot(&gradient_rate(v, r.grad), &cof) / j;
+        let (qq, qt) = bulk_pressure(bv, trd, R::splat(rho0) / j, l, resp.wave_speed);
         q = qq;
         qterm = qt;
-        if q != 0.0 {
-            p -= cof * q;
-            out.bulk_power = q * (-trd) * vol;
+        // P -= q cof F (zero where the element expands).
+        for i in 0..3 {
+            for k in 0..3 {
+                p[i][k] -= cof[i][k] * q;
+            }
         }
+        out.bulk_power = q * (-trd) * vol;
     }
     out.dt = critical_step(l, c, qterm);
-    *fe = [[0.0; 8]; 3];
+    *fe = [[R::zero(); 8]; 3];
     add_nodal_forces(fe, &p, r.grad, r.vol0);
     // Hourglass: generalised displacements (stiffness) or velocities (viscous) per mode.
     let (a, w) = match hg_form {
-        HourglassForm::Viscous => (r.hg_scale * density_scale.sqrt() * c, v),
+        HourglassForm::Viscous => (r.hg_scale * sqrt_scale * c, v),
         HourglassForm::Stiffness => (r.hg_scale, u),
     };
-    let mut qq = [[0.0; 4]; 3];
-    let mut sumsq = 0.0;
+    let mut qq = [[R::zero(); 4]; 3];
+    let mut sumsq = R::zero();
     for i in 0..3 {
         for al in 0..4 {
             let h = dot8(&w[i], &r.gamma[al]);
@@ -93,17 +100,16 @@ pub fn compute_forces<L: Law>(
     }
     match hg_form {
         HourglassForm::Viscous => out.hourglass_power = a * sumsq,
-        HourglassForm::Stiffness => out.hourglass_stored = 0.5 * a * sumsq,
+        HourglassForm::Stiffness => out.hourglass_stored = a * sumsq * 0.5,
     }
     if input.want_stress {
-        let mut sigma = f * resp.pk2 * f.transpose() / j;
-        sigma[(0, 0)] -= q;
-        sigma[(1, 1)] -= q;
-        sigma[(2, 2)] -= q;
+        let mut sigma = scale(&mul_bt(&mul(&f, &resp.pk2), &f), R::splat(1.0) / j);
+        for i in 0..3 {
+            sigma[i][i] -= q;
+        }
         out.cauchy = sym6(&sigma);
     }
-    if !(out.dt.is_finite() && fe.iter().all(|r| r.iter().all(|x| x.is_finite()))) {
-        return Err(LawError::NotFinite("element force"));
-    }
-    Ok(out)
+    let ok = out.dt.is_finite() & all_finite(fe);
+    out.fault_where(!ok, R::splat(FAULT_FORCE), out.dt);
+    out
 }

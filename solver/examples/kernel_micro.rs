@@ -1,0 +1,87 @@
+//! Times the one-point element kernel alone on one batch of eight elements held in cache:
+//! `cargo run --release -p solver --example kernel_micro`. Prints ns per element for the
+//! scalar kernel and the eight-lane kernel (baseline and, where available, AVX-512 builds).
+use material::real::{F64x8, Real};
+use material::{named, Material};
+use solver::element::{one_point, HourglassForm, Nodal, StepInput};
+use std::hint::black_box;
+use std::time::Instant;
+
+fn data<R: Real>(k: f64) -> (Nodal<R>, [[R; 8]; 4], Nodal<R>, Nodal<R>) {
+    let s = [-1.0, 1.0, 1.0, -1.0, -1.0, 1.0, 1.0, -1.0];
+    let t = [-1.0, -1.0, 1.0, 1.0, -1.0, -1.0, 1.0, 1.0];
+    let w = [-1.0, -1.0, -1.0, -1.0, 1.0, 1.0, 1.0, 1.0];
+    let h = 0.003;
+    let grad: Nodal<R> =
+        std::array::from_fn(|i| std::array::from_fn(|a| R::splat([s, t, w][i][a] / (4.0 * h))));
+    let gamma = std::array::from_fn(|m| {
+        std::array::from_fn(|a| {
+            R::splat([s[a] * t[a], t[a] * w[a], s[a] * w[a], s[a] * t[a] * w[a]][m] / 8.0)
+        })
+    });
+    let x: Nodal<R> =
+        std::array::from_fn(|i| std::array::from_fn(|a| R::splat([s, t, w][i][a] * h / 2.0)));
+    let u: Nodal<R> = std::array::from_fn(|i| {
+        std::array::from_fn(|a| R::splat(1e-5 * k * ((i * 8 + a) as f64).sin()))
+    });
+    (grad, gamma, x, u)
+}
+
+macro_rules! run {
+    ($law:expr, $R:ty, $n:expr) => {{
+        let (grad, gamma, x, u) = data::<$R>(1.0);
+        let r = one_point::OnePointRef {
+            grad: &grad,
+            gamma: &gamma,
+            vol0: <$R>::splat(2.7e-8),
+            hg_scale: <$R>::splat(1.0),
+        };
+        let input = StepInput {
+            dt: 1e-6,
+            bulk: Some(Default::default()),
+            want_stress: false,
+        };
+        let mut h = vec![<$R>::zero(); 64];
+        let mut fe: Nodal<$R> = [[<$R>::zero(); 8]; 3];
+        let t0 = Instant::now();
+        let mut acc = 0.0;
+        for _ in 0..$n {
+            let o = one_point::compute_forces(
+                black_box($law),
+                black_box(&r),
+                HourglassForm::Stiffness,
+                black_box(&x),
+                black_box(&u),
+                black_box(&u),
+                <$R>::splat(1.0),
+                &input,
+                &mut h,
+                &mut fe,
+            );
+            acc += o.dt.lane(0) + fe[0][0].lane(0);
+        }
+        (
+            t0.elapsed().as_secs_f64() / ($n as f64 * <$R>::LANES as f64) * 1e9,
+            acc,
+        )
+    }};
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx512f,avx512dq,avx512vl,avx512bw")]
+unsafe fn lanes512<L: material::Law>(l: &L, n: usize) -> (f64, f64) {
+    run!(l, F64x8, n)
+}
+
+fn main() {
+    for name in ["paper:flesh", "paper:liver"] {
+        let m: Material = named(name).unwrap().build(name).unwrap();
+        material::with_law!(&m, l => {
+            let n = 200_000;
+            let (s, _) = run!(l, f64, n);
+            let (v, _) = run!(l, F64x8, n / 8);
+            let v5 = if std::arch::is_x86_feature_detected!("avx512f") { unsafe { lanes512(l, n / 8).0 } } else { f64::NAN };
+            println!("{name}: scalar {s:.1} ns/element, 8 lanes {v:.1}, 8 lanes avx512 {v5:.1}");
+        });
+    }
+}
