@@ -283,12 +283,16 @@ pub struct Erosion {
     pub first: Option<(u32, f64)>,
 }
 
-const T_ELEMENTS: usize = 0;
-const T_GATHER: usize = 1;
-const T_LOADS: usize = 2;
-const T_CONTACT: usize = 3;
-const T_UPDATE: usize = 4;
-const T_MASS_SCALING: usize = 5;
+/// The timed stages of a step, in the order of [`Simulation::timers`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Stage {
+    Elements,
+    Gather,
+    Loads,
+    Contact,
+    Update,
+    MassScaling,
+}
 
 impl Simulation {
     /// Set up a simulation. Initial velocities may be given per node.
@@ -497,7 +501,7 @@ impl Simulation {
             &mut self.slots,
             stress,
         );
-        self.timers[T_ELEMENTS].time += t0.elapsed();
+        self.timers[Stage::Elements as usize].time += t0.elapsed();
         let tot = r.map_err(|(e, reason)| SolverError::ElementFailure {
             element: e,
             part: self.part_of(e),
@@ -506,7 +510,9 @@ impl Simulation {
         })?;
         self.totals = tot;
         if self.model.mass_scaling.is_some() {
-            self.time_stage(T_MASS_SCALING, |s| s.apply_run_time_mass_scaling())?;
+            self.time_stage(Stage::MassScaling as usize, |s| {
+                s.apply_run_time_mass_scaling()
+            })?;
         }
         self.erosion.count += tot.newly_eroded as u64;
         if self.erosion.first.is_none() {
@@ -519,7 +525,9 @@ impl Simulation {
             self.dt_next = self.settings.dt_factor * tot.dt_min;
             self.dt_element = tot.dt_elem;
         }
-        self.time_stage(T_GATHER, |s| gather(&s.model, &s.slots, &mut s.f_int));
+        self.time_stage(Stage::Gather as usize, |s| {
+            gather(&s.model, &s.slots, &mut s.f_int)
+        });
         Ok(())
     }
 
@@ -620,8 +628,9 @@ impl Simulation {
             .unwrap_or_default()
     }
 
-    /// External forces at time t: loads, gravity, then the force stages (contact).
-    fn external_forces(&mut self) {
+    /// External forces at time t: loads, gravity, then the force stages (contact), which book
+    /// their dissipation and regularise friction over the step `dt` about to be taken.
+    fn external_forces(&mut self, dt: f64) {
         let t = self.time;
         let t0 = Instant::now();
         match &self.gravity_force {
@@ -634,7 +643,7 @@ impl Simulation {
                 self.f_ext[n as usize][l.dof] += val;
             }
         }
-        self.timers[T_LOADS].time += t0.elapsed();
+        self.timers[Stage::Loads as usize].time += t0.elapsed();
         if !self.stages.is_empty() {
             let t0 = Instant::now();
             let nodes = &self.model.mesh.nodes;
@@ -643,11 +652,10 @@ impl Simulation {
             for (c, (p, d)) in cur.iter_mut().zip(nodes.iter().zip(self.u.iter())) {
                 *c = [p[0] + d[0], p[1] + d[1], p[2] + d[2]];
             }
-            let dt = self.dt_next;
             for st in self.stages.iter_mut() {
                 st.apply(t, dt, cur, &self.v, &mut self.f_ext);
             }
-            self.timers[T_CONTACT].time += t0.elapsed();
+            self.timers[Stage::Contact as usize].time += t0.elapsed();
         }
     }
 
@@ -664,7 +672,8 @@ impl Simulation {
     /// stress of the new state is stored in `self.stress` (when stress output was requested).
     pub fn step(&mut self, stress_at: f64) -> Result<(), SolverError> {
         self.initialise()?;
-        self.external_forces();
+        // The step is chosen first, with every clamp (dt_max, relaxation, a stage's own limit),
+        // and only then do the stages run with it.
         let mut dt = self.dt_next.min(self.settings.dt_max);
         if self.settings.relaxation.is_some() {
             // Dynamic relaxation steps in fictitious time with a step that never grows: a step
@@ -690,9 +699,10 @@ impl Simulation {
                 ),
             });
         }
+        self.external_forces(dt);
         let t0 = Instant::now();
         self.update(dt);
-        self.timers[T_UPDATE].time += t0.elapsed();
+        self.timers[Stage::Update as usize].time += t0.elapsed();
         self.step += 1;
         self.time += dt;
         self.dt_prev = dt;

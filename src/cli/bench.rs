@@ -14,7 +14,17 @@
 //! - `nh-fbar`: the same block with fully integrated F-bar elements;
 //! - `press`: the same block of the paper's flesh (simplified rubber/foam, K/G = 5e4, 2.8 mm
 //!   elements), pressed by the two-finger hand already in contact: the contact stage's share of
-//!   the step must stay at most 10 %.
+//!   the step must stay at most 10 %;
+//! - `ogden`: the same block of the paper's liver (Ogden, exponents 19 and -11, three Prony
+//!   terms), one-point elements with shear-scaled stiffness hourglass control, top velocity load.
+//!
+//! The memory roof: a STREAM-style triad `a = b + s c` over 3 x 64 MB, run on the same threads
+//! just before each case, gives the bandwidth; the bytes a step moves per element (its reference
+//! data, history read and written, element-force slots written and gathered, the gather table,
+//! and nodal arrays: three gathered and about seven swept by the update, per node) divided into
+//! it give the case's roof in element-cycles per second, and the table prints the fraction of
+//! that roof the case reaches. The bytes are a count of the arrays the step touches, not a
+//! hardware measurement: cache reuse of the gathered nodal data can beat the roof.
 
 use solver::scene::build::build_scene;
 use solver::scene::SceneSpec;
@@ -80,7 +90,14 @@ motion = { kind = "velocity", curve = { kind = "constant", value = "0.6 m/s" } }
 surface = "zmax"
 "#
         .to_string(),
-        o => return Err(format!("unknown bench case `{o}` (nh-1pt, nh-fbar, press)")),
+        "ogden" => format!(
+            "{top_load}[[part]]\nname = \"body\"\nmaterial = \"paper:liver\"\nhourglass = \"stiffness\"\nhourglass_modulus = \"shear\"\n"
+        ),
+        o => {
+            return Err(format!(
+                "unknown bench case `{o}` (nh-1pt, nh-fbar, press, ogden)"
+            ))
+        }
     };
     Ok(format!(
         "[run]\ntitle = \"bench {case}\"\nend_time = \"1 s\"\n{BLOCK}{body}"
@@ -92,6 +109,52 @@ struct Measured {
     elements: usize,
     seconds: f64,
     stages: Vec<(&'static str, f64)>,
+    /// Bytes the step moves per element-cycle (see the module doc).
+    bytes_per_element: f64,
+    /// Triad bandwidth measured on the same threads just before (bytes/s).
+    bandwidth: f64,
+}
+
+/// STREAM-style triad bandwidth (bytes/s) on the current rayon pool: best of three passes over
+/// three arrays of 8 M doubles (3 x 64 MB, far beyond any cache), counting 24 bytes per index.
+fn triad_bandwidth() -> f64 {
+    use rayon::prelude::*;
+    let n = 8 << 20;
+    let b = vec![1.0f64; n];
+    let c = vec![2.0f64; n];
+    let mut a = vec![0.0f64; n];
+    let mut best = f64::INFINITY;
+    for _ in 0..3 {
+        let t0 = Instant::now();
+        a.par_chunks_mut(1 << 16)
+            .zip(b.par_chunks(1 << 16).zip(c.par_chunks(1 << 16)))
+            .for_each(|(a, (b, c))| {
+                for ((a, b), c) in a.iter_mut().zip(b).zip(c) {
+                    *a = b + 3.0 * c;
+                }
+            });
+        best = best.min(t0.elapsed().as_secs_f64());
+        std::hint::black_box(&a);
+    }
+    (24 * n) as f64 / best
+}
+
+/// Bytes one step moves per element (module doc): reference data and history of every group,
+/// element-force slots (written, then read by the gather), the gather table, and 10 nodal
+/// arrays of 24 bytes.
+fn step_bytes_per_element(m: &solver::model::Model) -> f64 {
+    let mut bytes = 0usize;
+    for g in &m.groups {
+        bytes += g.conn.len() * (32 + 8 + 8)
+            + std::mem::size_of_val(g.grad.as_slice())
+            + std::mem::size_of_val(g.gamma.as_slice())
+            + std::mem::size_of_val(g.gp_grad.as_slice())
+            + std::mem::size_of_val(g.gp_weight.as_slice())
+            + 2 * std::mem::size_of_val(g.history.as_slice())
+            + 8 * g.density_scale.len();
+    }
+    bytes += 2 * m.n_slots * 24 * 8 + 4 * m.gather_idx.len() + 10 * 24 * m.mesh.nodes.len();
+    bytes as f64 / m.mesh.elements.len() as f64
 }
 
 fn measure(case: &str, threads: usize, steps: usize) -> Result<Measured, String> {
@@ -102,6 +165,7 @@ fn measure(case: &str, threads: usize, steps: usize) -> Result<Measured, String>
         .build()
         .map_err(|e| e.to_string())?;
     pool.install(|| {
+        let bandwidth = triad_bandwidth();
         let mut scene = build_scene(spec, Path::new(&format!("bench-{case}.toml")), &src)?;
         let sim = &mut scene.sim;
         sim.initialise().map_err(|e| e.to_string())?;
@@ -116,6 +180,8 @@ fn measure(case: &str, threads: usize, steps: usize) -> Result<Measured, String>
         let total: f64 = sim.timers.iter().map(|t| t.time.as_secs_f64()).sum();
         Ok(Measured {
             elements: sim.model.mesh.elements.len(),
+            bytes_per_element: step_bytes_per_element(&sim.model),
+            bandwidth,
             seconds,
             stages: sim
                 .timers
@@ -136,11 +202,22 @@ pub fn bench(cases: &[String], threads: &[usize], steps: usize) -> Result<(), St
         return Err("--threads: every thread count must be at least 1".into());
     }
     println!(
-        "palpa bench: {steps} steps per case, element-cycles per second = elements x steps / wall time"
+        "palpa bench: {steps} steps per case, element-cycles per second = elements x steps / wall time; \
+         element kernels: {} (8 lanes of f64)",
+        solver::forces::simd_level()
     );
     println!(
-        "{:<8} {:>7} {:>9} {:>9} {:>12} {:>8}  stage shares",
-        "case", "threads", "elements", "wall s", "M el-cyc/s", "speedup"
+        "{:<8} {:>7} {:>9} {:>9} {:>12} {:>8} {:>7} {:>9} {:>10} {:>7}  stage shares",
+        "case",
+        "threads",
+        "elements",
+        "wall s",
+        "M el-cyc/s",
+        "speedup",
+        "B/el",
+        "triad GB/s",
+        "roof M/s",
+        "of roof"
     );
     for case in cases {
         let mut base = None;
@@ -159,12 +236,17 @@ pub fn bench(cases: &[String], threads: &[usize], steps: usize) -> Result<(), St
                 .iter()
                 .map(|(n, s)| format!("{n} {:.1} %", 100.0 * s))
                 .collect();
+            let roof = m.bandwidth / m.bytes_per_element;
             println!(
-                "{case:<8} {t:>7} {:>9} {:>9.3} {:>12.3} {:>8.2}  {}",
+                "{case:<8} {t:>7} {:>9} {:>9.3} {:>12.3} {:>8.2} {:>7.0} {:>10.1} {:>10.1} {:>6.0} %  {}",
                 m.elements,
                 m.seconds,
                 rate / 1e6,
                 speedup,
+                m.bytes_per_element,
+                m.bandwidth / 1e9,
+                roof / 1e6,
+                100.0 * rate / roof,
                 shares.join(", ")
             );
         }
@@ -178,7 +260,7 @@ mod tests {
 
     #[test]
     fn every_case_scene_parses() {
-        for c in ["nh-1pt", "nh-fbar", "press"] {
+        for c in ["nh-1pt", "nh-fbar", "press", "ogden"] {
             let src = case_scene(c).unwrap();
             let _: SceneSpec = toml::from_str(&src).unwrap();
         }

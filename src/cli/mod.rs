@@ -104,11 +104,11 @@ enum Command {
     /// accuracy-versus-cost table (Fit, training time, prediction latency).
     Evaluate(evaluate::EvaluateArgs),
     /// Whole-run throughput: element-cycles per second of 100k-element blocks (neo-Hookean
-    /// one-point and F-bar, and the two-finger press on the paper's flesh with the contact
-    /// stage's share), on each thread count, measured in one invocation.
+    /// one-point and F-bar, the two-finger press on the paper's flesh with the contact
+    /// stage's share, and the paper's liver), with the memory roof, on each thread count.
     Bench {
-        /// Cases: nh-1pt, nh-fbar, press.
-        #[arg(long, value_delimiter = ',', default_values_t = ["nh-1pt".to_string(), "nh-fbar".to_string(), "press".to_string()])]
+        /// Cases: nh-1pt, nh-fbar, press, ogden.
+        #[arg(long, value_delimiter = ',', default_values_t = ["nh-1pt".to_string(), "nh-fbar".to_string(), "press".to_string(), "ogden".to_string()])]
         cases: Vec<String>,
         /// Thread counts to compare.
         #[arg(long, value_delimiter = ',', default_values_t = [1usize, 2])]
