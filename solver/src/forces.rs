@@ -265,13 +265,24 @@ fn run_chunk_body<L: Law>(l: &L, b: &Batch, ci: usize, fch: &mut [Nodal<F64x8>])
                 full::compute_forces(l, &rf, fbar, &xe, &ue, &ve, s, b.input, h, fe)
             }
         };
+        let (fault_l, fault_v) = (o.fault.to_array(), o.fault_value.to_array());
+        let (dt_l, hs_l, hp_l) = (
+            o.dt.to_array(),
+            o.hourglass_stored.to_array(),
+            o.hourglass_power.to_array(),
+        );
+        let (bulk_l, diss_l, s_l) = (
+            o.bulk_power.to_array(),
+            o.law_dissipation.to_array(),
+            s.to_array(),
+        );
         for q in 0..nvalid {
             let le = le0 + q;
             let eroded = !g.eroded.is_empty() && g.eroded[le];
-            let fault = o.fault.lane(q);
+            let fault = fault_l[q];
             if eroded || fault != 0.0 {
                 if !eroded && acc.error.is_none() {
-                    let e = fault_error(fault, o.fault_value.lane(q), l.name());
+                    let e = fault_error(fault, fault_v[q], l.name());
                     acc.error = Some((g.elements[le], e.to_string()));
                 }
                 for row in fe.iter_mut() {
@@ -281,18 +292,18 @@ fn run_chunk_body<L: Law>(l: &L, b: &Batch, ci: usize, fch: &mut [Nodal<F64x8>])
                 }
                 continue;
             }
-            let mut dt = o.dt.lane(q);
+            let mut dt = dt_l[q];
             if dt < g.dt_floor {
                 // Run-time mass scaling: dt grows with sqrt(density scale).
                 let r = g.dt_floor / dt;
-                acc.rescale.push((le as u32, s.lane(q) * r * r));
+                acc.rescale.push((le as u32, s_l[q] * r * r));
                 dt = g.dt_floor;
             }
             if dt < acc.dt_min {
                 acc.dt_min = dt;
                 acc.dt_elem = g.elements[le];
             }
-            let (hs, hp) = (o.hourglass_stored.lane(q), o.hourglass_power.lane(q));
+            let (hs, hp) = (hs_l[q], hp_l[q]);
             acc.hg_stored += hs;
             acc.hg_power += hp;
             let hg = hs + hp * b.input.dt;
@@ -300,8 +311,8 @@ fn run_chunk_body<L: Law>(l: &L, b: &Batch, ci: usize, fch: &mut [Nodal<F64x8>])
                 acc.hg_peak = hg;
                 acc.hg_peak_elem = g.elements[le];
             }
-            acc.bulk_power += o.bulk_power.lane(q);
-            acc.law_dissipation += o.law_dissipation.lane(q);
+            acc.bulk_power += bulk_l[q];
+            acc.law_dissipation += diss_l[q];
             if o.failed.lane(q) {
                 acc.failed.push(le as u32);
             }
@@ -321,17 +332,24 @@ fn run_chunk_body<L: Law>(l: &L, b: &Batch, ci: usize, fch: &mut [Nodal<F64x8>])
 pub fn gather(model: &Model, slots: &[Nodal<F64x8>], f: &mut [[f64; 3]]) {
     let ptr = &model.gather_ptr;
     let idx = &model.gather_idx;
+    // The slots as plain numbers: batch b, component i, node a, lane q at
+    // ((b * 3 + i) * 8 + a) * LANES + q (lane vectors are arrays of f64 in memory).
+    // SAFETY: F64x8 is a transparent wrapper of wide's f64x8, a plain (repr(C)) block of eight
+    // f64, so a slot batch is 3 * 8 * LANES contiguous f64 with no padding.
+    let flat: &[f64] = unsafe {
+        std::slice::from_raw_parts(slots.as_ptr() as *const f64, slots.len() * 3 * 8 * LANES)
+    };
+    const PER_BATCH: usize = 3 * 8 * LANES;
     f.par_chunks_mut(4096).enumerate().for_each(|(ci, ch)| {
         for (k, fn_) in ch.iter_mut().enumerate() {
             let n = ci * 4096 + k;
             let mut s = [0.0; 3];
             for &sl in &idx[ptr[n] as usize..ptr[n + 1] as usize] {
                 let (e, a) = ((sl >> 3) as usize, (sl & 7) as usize);
-                let v = &slots[e / LANES];
-                let q = e % LANES;
-                s[0] += v[0][a].lane(q);
-                s[1] += v[1][a].lane(q);
-                s[2] += v[2][a].lane(q);
+                let base = (e / LANES) * PER_BATCH + a * LANES + e % LANES;
+                s[0] += flat[base];
+                s[1] += flat[base + 8 * LANES];
+                s[2] += flat[base + 16 * LANES];
             }
             *fn_ = s;
         }
