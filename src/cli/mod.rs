@@ -14,6 +14,7 @@ mod study;
 mod train;
 mod units;
 mod verify;
+mod view_geometry;
 
 use clap::{Parser, Subcommand};
 use std::path::PathBuf;

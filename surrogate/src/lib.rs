@@ -21,6 +21,8 @@
 //! - [`view`]: the plan-view geometry that travels with a model (`view.json`).
 //! - [`colour`] and [`render`]: the colour scale and the stress picture as a PNG
 //!   ([`render_picture`]).
+//! - [`serving`]: a model with its geometry and domain, as `palpa predict --png` and
+//!   `palpa serve` show it ([`ServedModel`]).
 //! - [`sensor`]: the live inputs of `palpa serve`: the force plate's four load cells, its
 //!   calibration to the body, the force filter and recorded sensor logs.
 //!
@@ -46,6 +48,7 @@ pub mod render;
 pub mod report;
 pub mod rng;
 pub mod sensor;
+pub mod serving;
 pub mod synthetic;
 pub mod target;
 pub mod tensor_file;
@@ -63,5 +66,6 @@ pub use fit::{compute_fit, compute_fit_by_location};
 pub use model::{ModelKind, ModelMeta, Predictor, TrainedModel};
 pub use render::{render_map, render_picture, Hand, Picture};
 pub use report::{CostRow, EvaluationReport, LocationFit, TrainReport};
+pub use serving::{Served, ServedModel, Warning};
 pub use target::Target;
 pub use view::ViewGeometry;

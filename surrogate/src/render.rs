@@ -30,7 +30,7 @@ use std::path::Path;
 /// Image size in pixels.
 pub const SIZE: (u32, u32) = (1000, 760);
 /// The map's rectangle in the image: left, top, width, height (px).
-const MAP: (i32, i32, i32, i32) = (80, 100, 760, 620);
+const MAP: (i32, i32, i32, i32) = (80, 116, 760, 604);
 
 /// The colours of the picture's outlines (RGB), shared with the live page so both draw alike.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize)]
@@ -149,17 +149,13 @@ pub fn title(hand: Option<Hand>, time_s: Option<f64>) -> String {
     }
 }
 
-/// The cells of a picture: the view's footprints, or squares around the centroids.
-fn cells(p: &Picture) -> Vec<Ring> {
-    if let Some(v) = p.view {
+/// The cells of a picture: the view's footprints, or squares around the centroids (R x 2 or
+/// R x 3, m) as wide as the median nearest-neighbour distance in plan (1 to 10 mm).
+pub fn roi_cells(view: Option<&ViewGeometry>, centroids: ArrayView2<f64>) -> Vec<Ring> {
+    if let Some(v) = view {
         return v.roi_cells.clone();
     }
-    let c: Vec<[f64; 2]> = p
-        .centroids
-        .rows()
-        .into_iter()
-        .map(|r| [r[0], r[1]])
-        .collect();
+    let c: Vec<[f64; 2]> = centroids.rows().into_iter().map(|r| [r[0], r[1]]).collect();
     let mut nn: Vec<f64> = c
         .iter()
         .enumerate()
@@ -191,18 +187,37 @@ fn cells(p: &Picture) -> Vec<Ring> {
         .collect()
 }
 
-/// The picture's extent in the plan frame (m): the liver, the cells, the hull and the fingers,
-/// with a margin.
-pub fn extent(p: &Picture, cells: &[Ring]) -> ([f64; 2], [f64; 2]) {
+fn cells(p: &Picture) -> Vec<Ring> {
+    roi_cells(p.view, p.centroids)
+}
+
+/// The picture's extent in the plan frame (m): the liver, the cells, the reduced model's box
+/// (so that some of the body's surroundings show), the training hull and `extra` points (the
+/// fingers), with a 15 mm margin. The live page uses it too.
+pub fn plan_extent(
+    view: Option<&ViewGeometry>,
+    cells: &[Ring],
+    hull: Option<&[[f64; 2]]>,
+    extra: &[[f64; 2]],
+) -> ([f64; 2], [f64; 2]) {
+    let mut pts: Vec<[f64; 2]> = hull.map(|h| h.to_vec()).unwrap_or_default();
+    pts.extend_from_slice(extra);
+    if let Some(v) = view {
+        if let Some(b) = &v.model_box {
+            pts.extend_from_slice(b);
+        }
+        pts.extend(v.liver.iter().flatten());
+    }
+    bounds(cells.iter().flatten().chain(pts.iter()), 0.015)
+}
+
+fn extent(p: &Picture, cells: &[Ring]) -> ([f64; 2], [f64; 2]) {
     let fingers = p.view.map(|v| v.fingers.clone()).unwrap_or_default();
-    let mut extra: Vec<[f64; 2]> = p.hull.map(|h| h.to_vec()).unwrap_or_default();
-    if let Some(h) = p.hand {
-        extra.extend(fingers.centres(h.x, h.y));
-    }
-    match p.view {
-        Some(v) => v.extent(&extra, 0.015),
-        None => bounds(cells.iter().flatten().chain(extra.iter()), 0.010),
-    }
+    let extra: Vec<[f64; 2]> = p
+        .hand
+        .map(|h| fingers.centres(h.x, h.y).to_vec())
+        .unwrap_or_default();
+    plan_extent(p.view, cells, p.hull, &extra)
 }
 
 /// A world (m) to pixel map that keeps the aspect ratio, centred in a `w` x `h` rectangle.
@@ -420,14 +435,14 @@ fn tick_step(span: f64) -> f64 {
 fn draw_frame(root: &Area, p: &Picture, lo: [f64; 2], hi: [f64; 2], tf: Transform) -> DrawResult {
     let (mx, my, mw, mh) = MAP;
     let black = rgb(PALETTE.text);
-    text(root, &title(p.hand, p.time_s), 20, 14, 2, PALETTE.text)?;
-    text(root, &p.subtitle, 20, 40, 1, PALETTE.text)?;
-    for (k, w) in p.warnings.iter().take(3).enumerate() {
+    text(root, &title(p.hand, p.time_s), 20, 12, 2, PALETTE.text)?;
+    text(root, &p.subtitle, 20, 36, 1, PALETTE.text)?;
+    for (k, w) in p.warnings.iter().take(4).enumerate() {
         text(
             root,
             &format!("! {w}"),
             20,
-            56 + 12 * k as i32,
+            50 + 11 * k as i32,
             1,
             PALETTE.warning,
         )?;
@@ -494,11 +509,10 @@ fn draw_frame(root: &Area, p: &Picture, lo: [f64; 2], hi: [f64; 2], tf: Transfor
         1,
         PALETTE.text,
     )?;
-    text(root, "y [mm]", 8, my - 14, 1, PALETTE.text)?;
-    text(root, "cranial", 8, my - 4 + 8, 1, PALETTE.text)?;
+    text(root, "y [mm], cranial", 8, my - 14, 1, PALETTE.text)?;
 
     // colour bar
-    let (bx, by, bw, bh) = (875, 130, 30, 560);
+    let (bx, by, bw, bh) = (875, 146, 30, 560);
     text(root, "kPa", bx, by - 26, 2, PALETTE.text)?;
     for k in 0..bh {
         let t = 1.0 - k as f64 / (bh - 1) as f64;
@@ -588,7 +602,7 @@ mod tests {
             let at = (((MAP.1 + py) * w as i32 + MAP.0 + px) * 3) as usize;
             assert_eq!(&img[at..at + 3], &scale.rgb(*v), "cell {k}");
         }
-        let title_ink = (14..30)
+        let title_ink = (12..28)
             .flat_map(|y| (20..400).map(move |x| (y * w as usize + x) * 3))
             .filter(|&i| img[i] < 100)
             .count();

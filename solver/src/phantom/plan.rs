@@ -11,7 +11,9 @@
 //!   function, the contour follows the implicit liver rather than a voxel staircase.
 //! - **Ribs**: the columns whose anterior half (above the torso outline's centre) holds a rib,
 //!   costal cartilage or sternum point (`Anatomy::in_ribs`, every [`Z_STEP`] in z): the level
-//!   1/2 contour of that 0/1 mask, so the ribs a trainee's fingers meet from the front.
+//!   1/2 contour of that 0/1 mask, sampled every `step / 2` (a mask has no sub-grid
+//!   information, so it takes the finer grid), so the ribs a trainee's fingers meet from the
+//!   front.
 //!
 //! Contours are traced by marching squares (the 2-D case of Lorensen & Cline, "Marching
 //! cubes", SIGGRAPH 1987): each grid cell's corners above the level give one of 16 cases, the
@@ -81,7 +83,8 @@ pub fn plan_view(ph: &Phantom, step: f64) -> PlanView {
             .fold(-1.0, f64::max)
     });
     let zc = an.centre_height();
-    let rib_field = grid.sample(|x, y| {
+    let rib_grid = Grid::over([-a, 0.0], [a, len], step / 2.0);
+    let rib_field = rib_grid.sample(|x, y| {
         let hit = (0..nz)
             .map(|k| k as f64 * Z_STEP)
             .filter(|&z| z > zc && an.inside(x, z))
@@ -94,7 +97,7 @@ pub fn plan_view(ph: &Phantom, step: f64) -> PlanView {
     });
     let tol = step / 4.0;
     let liver = grid.contours(&liver_field, 0.0, -1.0, tol);
-    let ribs = grid.contours(&rib_field, 0.5, 0.0, tol);
+    let ribs = rib_grid.contours(&rib_field, 0.5, 0.0, tol);
     PlanView {
         torso,
         model_box,
