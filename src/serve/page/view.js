@@ -12,22 +12,27 @@
 "use strict";
 
 const palpa = (() => {
-  const canvas = document.getElementById("view");
+  const canvas = document.getElementById("view");     // what changes: cells, fingers
   const ctx = canvas.getContext("2d");
+  const back = document.getElementById("static");     // what does not: outlines, ticks
   const stage = document.getElementById("stage");
   const el = (id) => document.getElementById(id);
   let scene = null;
   let frame = null;        // newest frame from the server
   let devMap = null;       // newest deviation map
   let dirty = false;       // a frame arrived since the last paint
-  let staticLayer = null;  // outlines, pre-drawn
+  let paths = null;        // Path2D of the cells, the liver and the hull, in CSS px
   let tf = { s: 1, ox: 0, oy: 0 };
   let ws = null;
   const pending = [];      // stamps of the frames that arrived since the last paint
-  const stats = { t0: performance.now(), painted: 0, rafs: 0, latencies: [], superseded: 0 };
+  const stats = { t0: performance.now(), painted: 0, rafs: 0, latencies: [], superseded: 0,
+    drawMs: 0, drawMaxMs: 0 };
   const recent = [];       // paint times of the last second, for the live figure
   const recentLat = [];    // the last latencies, for the live figure
   let placed = null;       // where the pointer last pressed [m]
+  // ?continuous: repaint every animation frame, new data or not (a load test of the page;
+  // by default it paints only when a frame has arrived)
+  const continuous = new URLSearchParams(location.search).has("continuous");
 
   const rgb = (c) => `rgb(${c[0]},${c[1]},${c[2]})`;
   const nowEpoch = () => performance.timeOrigin + performance.now();
@@ -36,8 +41,10 @@ const palpa = (() => {
   function fit() {
     const r = canvas.getBoundingClientRect();
     const dpr = window.devicePixelRatio || 1;
-    canvas.width = Math.round(r.width * dpr);
-    canvas.height = Math.round(r.height * dpr);
+    for (const c of [canvas, back]) {
+      c.width = Math.round(r.width * dpr);
+      c.height = Math.round(r.height * dpr);
+    }
     const [lo, hi] = [scene.extent.lo, scene.extent.hi];
     const s = Math.min(r.width / (hi[0] - lo[0]), r.height / (hi[1] - lo[1]));
     tf = {
@@ -46,7 +53,20 @@ const palpa = (() => {
       oy: (r.height + s * (hi[1] - lo[1])) / 2 + s * lo[1],
     };
     drawStatic(dpr, r.width, r.height);
+    const ring = (pts) => { const p = new Path2D(); addRing(p, pts); return p; };
+    paths = {
+      cells: scene.cells.map(ring),
+      liver: scene.view ? scene.view.liver.map(ring) : [],
+      hull: scene.domain ? ring(scene.domain.hull) : null,
+    };
     dirty = true;
+  }
+  function addRing(p, ring) {
+    ring.forEach((q, k) => {
+      const [x, y] = px(q);
+      if (k === 0) p.moveTo(x, y); else p.lineTo(x, y);
+    });
+    p.closePath();
   }
   const px = (p) => [tf.ox + tf.s * p[0], tf.oy - tf.s * p[1]];
   const world = (cx, cy) => [(cx - tf.ox) / tf.s, (tf.oy - cy) / tf.s];
@@ -61,10 +81,7 @@ const palpa = (() => {
   }
 
   function drawStatic(dpr, w, h) {
-    staticLayer = document.createElement("canvas");
-    staticLayer.width = canvas.width;
-    staticLayer.height = canvas.height;
-    const c = staticLayer.getContext("2d");
+    const c = back.getContext("2d");
     c.setTransform(dpr, 0, 0, dpr, 0, 0);
     const pal = scene.palette;
     c.fillStyle = rgb(pal.background);
@@ -115,9 +132,8 @@ const palpa = (() => {
 
   function draw() {
     const dpr = window.devicePixelRatio || 1;
-    const r = canvas.getBoundingClientRect();
     ctx.setTransform(1, 0, 0, 1, 0, 0);
-    ctx.drawImage(staticLayer, 0, 0);
+    ctx.clearRect(0, 0, canvas.width, canvas.height);
     ctx.setTransform(dpr, 0, 0, dpr, 0, 0);
     const pal = scene.palette;
     if (frame) {
@@ -126,25 +142,21 @@ const palpa = (() => {
       const order = s.map((_, i) => i).sort((a, b) => s[a] - s[b]);
       for (const i of order) {
         ctx.fillStyle = lutColour(s[i]);
-        path(ctx, scene.cells[i]);
-        ctx.fill();
+        ctx.fill(paths.cells[i]);
       }
     }
-    if (scene.view) {
-      ctx.strokeStyle = rgb(pal.liver_line);
-      ctx.lineWidth = 2;
-      scene.view.liver.forEach((l) => { path(ctx, l); ctx.stroke(); });
-    }
-    if (scene.domain) {
+    ctx.strokeStyle = rgb(pal.liver_line);
+    ctx.lineWidth = 2;
+    paths.liver.forEach((l) => ctx.stroke(l));
+    if (paths.hull) {
       ctx.setLineDash([1, 4]);
       ctx.strokeStyle = rgb(pal.hull);
       ctx.lineWidth = 1.5;
-      path(ctx, scene.domain.hull); ctx.stroke();
+      ctx.stroke(paths.hull);
       ctx.setLineDash([]);
     }
     if (devMap && el("deviation").checked) drawDeviation();
     if (frame) drawFingers(pal);
-    drawGauge();
   }
 
   function drawFingers(pal) {
@@ -182,7 +194,11 @@ const palpa = (() => {
     }
   }
 
+  let gaugeForce = -1;
   function drawGauge() {
+    const f = frame ? frame.force : 0;
+    if (Math.abs(f - gaugeForce) < 0.05) return;
+    gaugeForce = f;
     const g = el("gauge");
     const c = g.getContext("2d");
     const lim = scene.force_limit_n;
@@ -190,7 +206,6 @@ const palpa = (() => {
     const yOf = (f) => bot - (bot - top) * Math.min(1, f / lim);
     c.clearRect(0, 0, g.width, g.height);
     c.fillStyle = "#eee"; c.fillRect(x0, top, w, bot - top);
-    const f = frame ? frame.force : 0;
     const over = scene.domain && f > scene.domain.force_max_n;
     c.fillStyle = over ? "#c80000" : "#2a6fb0";
     c.fillRect(x0, yOf(f), w, bot - yOf(f));
@@ -229,8 +244,18 @@ const palpa = (() => {
     }
   }
 
+  // the numbers at most 10 times a second (text layout costs more than the picture); the
+  // warning as soon as it changes
+  let shownAt = 0;
+  let shownWarnings = "";
   function showReadout() {
     if (!frame) return;
+    const wkey = frame.warnings.map((x) => x.code).join(",");
+    const t = performance.now();
+    if (t - shownAt < 100 && wkey === shownWarnings) return;
+    shownAt = t;
+    shownWarnings = wkey;
+    drawGauge();
     el("rx").textContent = (frame.x * 1e3).toFixed(1);
     el("ry").textContent = (frame.y * 1e3).toFixed(1);
     el("rf").textContent = frame.force.toFixed(1) + (frame.lifted ? " (lifted)" : "");
@@ -247,10 +272,14 @@ const palpa = (() => {
   // ---- the frame loop -----------------------------------------------------------------------
   function loop() {
     stats.rafs++;
-    if (dirty && scene && staticLayer) {
+    if ((dirty || continuous) && scene && paths) {
       dirty = false;
+      const t0 = performance.now();
       draw();
       showReadout();
+      const dt = performance.now() - t0;
+      stats.drawMs += dt;
+      stats.drawMaxMs = Math.max(stats.drawMaxMs, dt);
       const tp = nowEpoch();
       const tn = performance.now();
       for (const st of pending) {
@@ -400,13 +429,15 @@ const palpa = (() => {
     scene: () => scene,
     resetStats: () => {
       stats.t0 = performance.now(); stats.painted = 0; stats.rafs = 0;
-      stats.latencies = []; stats.superseded = 0;
+      stats.latencies = []; stats.superseded = 0; stats.drawMs = 0; stats.drawMaxMs = 0;
     },
     stats: () => ({
       seconds: (performance.now() - stats.t0) / 1e3,
       painted: stats.painted,
       rafs: stats.rafs,
       superseded: stats.superseded,
+      draw_mean_ms: stats.painted ? stats.drawMs / stats.painted : 0,
+      draw_max_ms: stats.drawMaxMs,
       latencies_ms: stats.latencies.slice(),
     }),
   };
