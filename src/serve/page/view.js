@@ -299,7 +299,7 @@ const palpa = (() => {
 
   setInterval(() => {
     el("sfps").textContent = recent.length.toString();
-    if (recentLat.length) {
+    if (recentLat.length >= 20) {
       const s = [...recentLat].sort((a, b) => a - b);
       const q = (p) => s[Math.min(s.length - 1, Math.floor(p * s.length))];
       el("slat").textContent = `p50 ${q(0.5).toFixed(1)} ms, p99 ${q(0.99).toFixed(1)} ms`;
