@@ -136,6 +136,7 @@ const palpa = (() => {
     ctx.clearRect(0, 0, canvas.width, canvas.height);
     ctx.setTransform(dpr, 0, 0, dpr, 0, 0);
     const pal = scene.palette;
+    if (devImage && el("deviation").checked) drawDeviation();
     if (frame) {
       // cells by rising stress: where elements overlap in plan, the largest shows
       const s = frame.stress;
@@ -155,7 +156,6 @@ const palpa = (() => {
       ctx.stroke(paths.hull);
       ctx.setLineDash([]);
     }
-    if (devMap && el("deviation").checked) drawDeviation();
     if (frame) drawFingers(pal);
   }
 
@@ -179,19 +179,34 @@ const palpa = (() => {
     ctx.stroke();
   }
 
-  function drawDeviation() {
+  // the deviation map as a small image (one pixel per grid point), scaled up smoothly: purple
+  // with opacity sd / prior (clear where the GP knows, opaque where it has no data)
+  let devImage = null;
+  function buildDeviation() {
     const g = devMap.grid;
     const prior = devMap.prior || 1;
+    const img = document.createElement("canvas");
+    img.width = g.nx;
+    img.height = g.ny;
+    const c = img.getContext("2d");
+    const data = c.createImageData(g.nx, g.ny);
     for (let j = 0; j < g.ny; j++) {
       for (let i = 0; i < g.nx; i++) {
         const sd = devMap.sd[j * g.nx + i];
-        if (sd == null) continue;
-        const a = Math.min(1, sd / prior) * 0.6;
-        ctx.fillStyle = `rgba(90,0,140,${a.toFixed(3)})`;
-        const [x0, y0] = px([g.x0 + (i - 0.5) * g.dx, g.y0 + (j + 0.5) * g.dy]);
-        ctx.fillRect(x0, y0, g.dx * tf.s + 0.5, g.dy * tf.s + 0.5);
+        const k = ((g.ny - 1 - j) * g.nx + i) * 4;   // image rows run downwards, y upwards
+        data.data[k] = 90; data.data[k + 1] = 0; data.data[k + 2] = 140;
+        data.data[k + 3] = sd == null ? 0 : Math.round(Math.min(1, sd / prior) * 0.6 * 255);
       }
     }
+    c.putImageData(data, 0, 0);
+    devImage = img;
+  }
+
+  function drawDeviation() {
+    const g = devMap.grid;
+    const [x0, y0] = px([g.x0 - g.dx / 2, g.y0 + (g.ny - 0.5) * g.dy]);
+    ctx.imageSmoothingEnabled = true;
+    ctx.drawImage(devImage, x0, y0, g.nx * g.dx * tf.s, g.ny * g.dy * tf.s);
   }
 
   let gaugeForce = -1;
@@ -325,6 +340,9 @@ const palpa = (() => {
         if (el("deviation").checked) requestDeviation(false);
       } else if (m.type === "deviation_map") {
         devMap = m;
+        buildDeviation();
+        el("dev-note").textContent = `purple: the GP's deviation at ${m.force.toFixed(0)} N, ` +
+          `opaque at its prior ${(m.prior / 1e3).toFixed(2)} kPa (no data there)`;
         dirty = true;
       } else if (m.type === "error") {
         const e = el("error");
@@ -390,6 +408,7 @@ const palpa = (() => {
   });
   el("deviation").addEventListener("change", () => {
     if (el("deviation").checked) requestDeviation(true);
+    el("dev-note").hidden = !el("deviation").checked;
     dirty = true;
   });
   let replaying = false;
