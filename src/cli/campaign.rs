@@ -292,13 +292,14 @@ fn run_campaign(a: &CampaignArgs) -> Result<(), String> {
     write_json(&cfile, &desc)?;
     let view = super::view_geometry::from_phantom(
         &phantom,
+        &phantom.mesh,
         super::view_geometry::fingers(campaign.base.finger_spacing, campaign.base.finger_diameter),
         format!(
             "campaign `{}` (palpa {})",
             campaign.title,
             env!("CARGO_PKG_VERSION")
         ),
-    );
+    )?;
     let vpath = out.join("view.json");
     view.write(&vpath)
         .map_err(|e| format!("{}: {e}", vpath.display()))?;

@@ -152,9 +152,10 @@ pub fn palpate(args: &PalpateArgs) -> Result<(), String> {
     let centroids = ph.roi.centroids.clone();
     let view = super::view_geometry::from_phantom(
         ph,
+        &scene.sim.model.mesh,
         super::view_geometry::fingers(setup.finger_spacing, setup.finger_diameter),
         format!("palpa palpate: {}", setup.title),
-    );
+    )?;
     let at = match &setup.place {
         Place::At(x, y) => [*x, *y],
         Place::Named(n) => {

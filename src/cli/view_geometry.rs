@@ -8,29 +8,39 @@
 //! committed default campaign), rebuilds the phantom from the manifest's `phantom.parameters`
 //! (a few seconds) and checks that its ROI is the dataset's, element for element.
 
+use solver::mesh::Mesh;
 use solver::phantom::{plan_view, Phantom, PLAN_STEP};
 use std::path::{Path, PathBuf};
 use surrogate::view::{convex_hull, Fingers, ViewGeometry, VIEW_FORMAT, VIEW_VERSION};
 
-/// The geometry of a built phantom, with the hand's `fingers`.
-pub fn from_phantom(ph: &Phantom, fingers: Fingers, source: String) -> ViewGeometry {
+/// The geometry of a built phantom whose mesh is `mesh` (the phantom's own, or the simulation's
+/// once a scene has taken it over), with the hand's `fingers`.
+pub fn from_phantom(
+    ph: &Phantom,
+    mesh: &Mesh,
+    fingers: Fingers,
+    source: String,
+) -> Result<ViewGeometry, String> {
     let plan = plan_view(ph, PLAN_STEP);
     let roi_cells = ph
         .roi
         .elements
         .iter()
         .map(|&e| {
-            let pts: Vec<[f64; 2]> = ph.mesh.elements[e as usize]
+            let nodes = mesh.elements.get(e as usize).ok_or_else(|| {
+                format!(
+                    "internal: ROI element {e} is not in the mesh of {} elements",
+                    mesh.elements.len()
+                )
+            })?;
+            let pts: Vec<[f64; 2]> = nodes
                 .iter()
-                .map(|&n| {
-                    let q = ph.mesh.nodes[n as usize];
-                    [q[0], q[1]]
-                })
+                .filter_map(|&n| mesh.nodes.get(n as usize).map(|q| [q[0], q[1]]))
                 .collect();
-            convex_hull(&pts)
+            Ok(convex_hull(&pts))
         })
-        .collect();
-    ViewGeometry {
+        .collect::<Result<Vec<_>, String>>()?;
+    let view = ViewGeometry {
         format: VIEW_FORMAT.into(),
         version: VIEW_VERSION,
         source,
@@ -42,7 +52,10 @@ pub fn from_phantom(ph: &Phantom, fingers: Fingers, source: String) -> ViewGeome
         roi_cells,
         fingers,
         respiratory_phase: ph.params.respiratory_phase,
-    }
+    };
+    view.validate()
+        .map_err(|e| format!("internal: plan view: {e}"))?;
+    Ok(view)
 }
 
 /// The hand of a palpation setup.
@@ -110,5 +123,5 @@ pub fn for_dataset(dataset: &Path) -> Result<Option<ViewGeometry>, String> {
         p.voxel * 1e3,
         env!("CARGO_PKG_VERSION")
     );
-    Ok(Some(from_phantom(&ph, f, source)))
+    from_phantom(&ph, &ph.mesh, f, source).map(Some)
 }
