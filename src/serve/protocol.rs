@@ -15,8 +15,9 @@
 //! frame it causes, for measuring latency; `t` is the sensor's own clock [s] for the force
 //! filter (the server's clock when absent). Anything else is an error sent back to the sender
 //! alone (`{"type": "error", "error": "..."}`): text that is not JSON or not an object, a missing
-//! or unknown type, an unknown or missing field, a number that is not finite, a negative force,
-//! a message longer than [`MAX_MESSAGE_BYTES`]. The server keeps serving.
+//! or unknown type, an unknown or missing field, a number that is not finite, a negative force
+//! or one above [`MAX_FORCE_N`], a position beyond [`MAX_POSITION_M`], a message longer than
+//! [`MAX_MESSAGE_BYTES`]. The server keeps serving.
 
 use serde::Deserialize;
 use serde_json::Value;
@@ -27,6 +28,10 @@ pub const MAX_MESSAGE_BYTES: usize = 16 * 1024;
 
 /// Largest force a press may ask for [N]: a palpation is tens of newtons.
 pub const MAX_FORCE_N: f64 = 1000.0;
+
+/// Largest plan coordinate a press may have [m]: a body is well inside it, and a position
+/// given in millimetres by mistake is well outside.
+pub const MAX_POSITION_M: f64 = 2.0;
 
 /// A replay command.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Deserialize)]
@@ -135,6 +140,17 @@ fn force_ok(name: &str, f: f64) -> Result<f64, String> {
     Ok(f)
 }
 
+fn position_ok(name: &str, v: f64) -> Result<f64, String> {
+    let v = finite(name, v, "m")?;
+    if v.abs() > MAX_POSITION_M {
+        return Err(format!(
+            "{name} = {v} m is more than {MAX_POSITION_M} m from the origin: not on a body \
+             (the unit is m, not mm)"
+        ));
+    }
+    Ok(v)
+}
+
 fn stamp_ok(s: Option<f64>) -> Result<Option<f64>, String> {
     s.map(|v| finite("stamp", v, "ms since the Unix epoch"))
         .transpose()
@@ -166,8 +182,8 @@ pub fn parse(text: &str) -> Result<ClientMessage, String> {
         "pointer" => {
             let m: PointerMsg = serde_json::from_value(rest).map_err(bad)?;
             Ok(ClientMessage::Pointer {
-                x: finite("x", m.x, "m")?,
-                y: finite("y", m.y, "m")?,
+                x: position_ok("x", m.x)?,
+                y: position_ok("y", m.y)?,
                 force: force_ok("force", m.force)?,
                 stamp: stamp_ok(m.stamp)?,
             })
