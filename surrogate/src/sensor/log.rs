@@ -225,13 +225,13 @@ impl SensorLog {
         for s in &self.samples {
             let _ = write!(out, "{}", s.time_s);
             for k in 0..4 {
-                for a in 0..3 {
-                    let _ = write!(out, ",{}", s.loads.force[k][a]);
+                for v in s.loads.force[k] {
+                    let _ = write!(out, ",{v}");
                 }
                 if moments {
                     let m = s.loads.moment.unwrap_or([[0.0; 3]; 4]);
-                    for a in 0..3 {
-                        let _ = write!(out, ",{}", m[k][a]);
+                    for v in m[k] {
+                        let _ = write!(out, ",{v}");
                     }
                 }
             }
