@@ -23,8 +23,9 @@
 //!    frame-rate limit off (`--disable-frame-rate-limit --disable-gpu-vsync`) and the page
 //!    repainting every animation frame (`?continuous`): how fast it can paint while the
 //!    stream plays; >= 60 painted frames/s asserted.
-//!    A busy machine can spoil one run: each mode gets a second try, and every run's figures
-//!    are printed and written to `target/browser/latency.json`. For the record (not asserted),
+//!    A busy machine can spoil a run (other processes delay the renderer's frames): the
+//!    display-paced mode gets up to three tries and the unthrottled one two, and every run's
+//!    figures are printed and written to `target/browser/latency.json`. For the record (not asserted),
 //!    the same figures for the page's own pointer: a drag at 60 moves/s, whose messages make a
 //!    round trip through the server before they are painted.
 
@@ -47,6 +48,10 @@ use tungstenite::{Message, WebSocket};
 
 /// One browser at a time: the two tests must not compete for the cores.
 static SERIAL: Mutex<()> = Mutex::new(());
+
+/// Flags of every run besides the defaults above: software compositing (no GPU process
+/// emulating GL), which leaves more of a small machine to the page.
+const BROWSER_FLAGS: &[&str] = &["--disable-gpu"];
 
 /// Viewport of the page (CSS px, device scale 1).
 const VIEWPORT: (u32, u32) = (1280, 800);
@@ -110,6 +115,7 @@ impl Browser {
             ])
             .arg(format!("--window-size={},{}", VIEWPORT.0, VIEWPORT.1))
             .arg(format!("--user-data-dir={}", profile.path().display()))
+            .args(BROWSER_FLAGS)
             .args(extra)
             .arg("about:blank")
             .stdout(Stdio::null())
@@ -771,7 +777,7 @@ fn latency_under_a_100_hz_plate_stream() {
     let mut report = Vec::new();
     // at the display's pace
     let mut paced = Vec::new();
-    for attempt in 1..=2 {
+    for attempt in 1..=3 {
         let r = streamed_run(&exe, &[], "");
         println!(
             "display-paced run {attempt}: {} messages at 100 Hz, {} measured; input to paint \
