@@ -1,6 +1,8 @@
-//! `palpa`: the command-line front of the palpa explicit solver.
+//! `palpa`: the command-line front of the palpa explicit solver, and `palpa serve`, the live
+//! training view (a web front; `serve/`).
 
 mod cli;
+mod serve;
 
 use clap::Parser;
 

@@ -8,6 +8,9 @@
 //!   duplicates no run, does not recompute the finished one (its `done.json` is unchanged) and
 //!   redoes an unfinished run directory from scratch; without `--resume` it refuses to touch
 //!   the finished runs;
+//! - the campaign writes its phantom's plan view (`view.json`) with the dataset's ROI; `palpa
+//!   train` puts it beside the model, or, for a dataset without one, rebuilds the phantom from
+//!   the manifest and derives the same geometry; a merge carries it over;
 //! - the shipped profiles (scenes/campaign-quick.toml, scenes/campaign-paper.toml,
 //!   scenes/campaign-5mm.toml, scenes/campaign-fbar-8mm.toml, scenes/campaign-wide-grid.toml,
 //!   scenes/campaign-convergence-2.5mm.toml)
@@ -17,7 +20,7 @@
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output, Stdio};
 use std::time::{Duration, Instant};
-use surrogate::Dataset;
+use surrogate::{Dataset, ViewGeometry};
 
 const TINY: &str = r#"
 title = "tiny"
@@ -128,6 +131,49 @@ fn chain_and_two_shards_merged_equal_one_unsharded_run() {
     let d = check_dataset(&full);
     assert_eq!(d.manifest.solver["version"], env!("CARGO_PKG_VERSION"));
 
+    // the plan view: the dataset's ROI, outlines, and the same geometry when train rebuilds it
+    let view = ViewGeometry::read(&full.join("view.json")).unwrap();
+    assert_eq!(view.roi_ids, d.roi_ids.to_vec());
+    assert!(!view.liver.is_empty() && !view.ribs.is_empty());
+    let model = tmp.path().join("gp");
+    ok(&["train", s(&full), "--model", "gp", "--out", s(&model)]);
+    assert_eq!(ViewGeometry::read(&model.join("view.json")).unwrap(), view);
+    let bare = tmp.path().join("bare");
+    std::fs::create_dir_all(&bare).unwrap();
+    for f in ["dataset.npz", "manifest.json"] {
+        std::fs::copy(full.join(f), bare.join(f)).unwrap();
+    }
+    let derived_model = tmp.path().join("gp-derived");
+    ok(&[
+        "train",
+        s(&bare),
+        "--model",
+        "gp",
+        "--out",
+        s(&derived_model),
+    ]);
+    let derived = ViewGeometry::read(&derived_model.join("view.json")).unwrap();
+    assert!(derived.source.contains("rebuilt"), "{}", derived.source);
+    assert_eq!(
+        ViewGeometry {
+            source: view.source.clone(),
+            ..derived
+        },
+        view,
+        "the phantom rebuilt from the manifest gives the campaign's geometry"
+    );
+    let png = tmp.path().join("map.png");
+    let out = ok(&[
+        "predict",
+        s(&model),
+        "--x=-0.05",
+        "--y=0.2",
+        "--force=1",
+        "--png",
+        s(&png),
+    ]);
+    assert!(png.is_file(), "{out}");
+
     let (s0, s1) = (tmp.path().join("s0"), tmp.path().join("s1"));
     ok(&[
         "campaign",
@@ -174,7 +220,7 @@ fn chain_and_two_shards_merged_equal_one_unsharded_run() {
         "--quiet",
     ]);
     assert_eq!(done_count(&merged), RUNS);
-    for f in ["dataset.npz", "manifest.json", "dataset.json"] {
+    for f in ["dataset.npz", "manifest.json", "dataset.json", "view.json"] {
         let a = std::fs::read(full.join(f)).unwrap();
         let b = std::fs::read(merged.join(f)).unwrap();
         assert!(

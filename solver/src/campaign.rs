@@ -760,6 +760,84 @@ pub fn phantom_json(p: &PhantomParams) -> serde_json::Value {
     })
 }
 
+/// The phantom parameters back from [`phantom_json`]'s JSON (a campaign's plan, a dataset
+/// manifest's `phantom.parameters`), so that the phantom of a dataset can be rebuilt without its
+/// campaign file. Meshing options other than `coarsen` take their defaults, as a campaign's do;
+/// the ROI centre is the default one (the liver's edge below the raster's centre) unless
+/// `roi_center` names another.
+pub fn phantom_params_from_json(
+    v: &serde_json::Value,
+    roi_center: Option<[f64; 3]>,
+) -> Result<PhantomParams, String> {
+    let num = |key: &str| {
+        v[key]
+            .as_f64()
+            .ok_or_else(|| format!("phantom parameters: `{key}` is missing or not a number"))
+    };
+    let arr = |val: &serde_json::Value, key: &str, n: usize| -> Result<Vec<f64>, String> {
+        let a = val
+            .as_array()
+            .filter(|a| a.len() == n)
+            .ok_or_else(|| format!("phantom parameters: `{key}` is not a list of {n} numbers"))?;
+        a.iter()
+            .map(|x| {
+                x.as_f64()
+                    .ok_or_else(|| format!("phantom parameters: `{key}` holds a non-number"))
+            })
+            .collect()
+    };
+    let mut p = PhantomParams {
+        variant: v["variant"]
+            .as_str()
+            .ok_or("phantom parameters: `variant` is missing")?
+            .parse()?,
+        voxel: num("voxel_m")?,
+        fat_thickness: num("fat_thickness_m")?,
+        respiratory_phase: num("respiratory_phase")?,
+        max_liver_shift: num("max_liver_shift_m")?,
+        ..Default::default()
+    };
+    let t = arr(&v["torso_m"], "torso_m", 3)?;
+    (p.torso_width, p.torso_depth, p.torso_length) = (t[0], t[1], t[2]);
+    p.mesh.coarsen = v["coarsen"].as_u64().unwrap_or(1) as usize;
+    if let Some(ts) = v["tumours"].as_array() {
+        for tv in ts {
+            let c = arr(&tv["center_m"], "tumours.center_m", 3)?;
+            p.tumours.push(crate::phantom::Tumour {
+                center: [c[0], c[1], c[2]],
+                radius: tv["radius_m"]
+                    .as_f64()
+                    .ok_or("phantom parameters: tumour radius")?,
+                stiffness_factor: tv["stiffness_factor"]
+                    .as_f64()
+                    .ok_or("phantom parameters: tumour stiffness")?,
+            });
+        }
+    }
+    p.roi.radius = num("roi_radius_m")?;
+    p.roi.max_count = v["roi_max_count"].as_u64().map(|n| n as usize);
+    let g = &v["grid"];
+    let c = arr(&g["center_m"], "grid.center_m", 2)?;
+    let sp = arr(&g["spacing_m"], "grid.spacing_m", 2)?;
+    let n = arr(&g["n"], "grid.n", 2)?;
+    p.grid = crate::phantom::GridParams {
+        center: [c[0], c[1]],
+        spacing: [sp[0], sp[1]],
+        n: [n[0] as usize, n[1] as usize],
+    };
+    if let Some(rc) = roi_center {
+        // the default centre, unless the given one is elsewhere (a JSON round trip may move
+        // the last digit: 1 nm decides)
+        let an = crate::phantom::Anatomy::new(&p);
+        let d = an.liver_edge_point(p.grid.center[0]);
+        if (0..3).any(|k| (d[k] - rc[k]).abs() > 1e-9) {
+            p.roi.center = Some(rc);
+        }
+    }
+    p.validate()?;
+    Ok(p)
+}
+
 /// Parse `i/n` (0 <= i < n).
 pub fn parse_shard(s: &str) -> Result<(usize, usize), String> {
     let bad = || format!("--shard: expected i/n with 0 <= i < n, e.g. 0/4, got `{s}`");
@@ -907,6 +985,27 @@ pub fn read_run(dir: &Path) -> Result<RunSamples, String> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The phantom parameters survive [`phantom_json`] and [`phantom_params_from_json`],
+    /// tumours, raster and ROI settings included.
+    #[test]
+    fn phantom_params_round_trip_through_json() {
+        let mut p = Campaign::paper().phantom_params().unwrap();
+        p.tumours.push(crate::phantom::Tumour {
+            center: [-0.06, 0.18, 0.15],
+            radius: 0.01,
+            stiffness_factor: 5.0,
+        });
+        p.respiratory_phase = 0.25;
+        p.grid.n = [3, 4];
+        let text = serde_json::to_string(&phantom_json(&p)).unwrap();
+        let back = phantom_params_from_json(&serde_json::from_str(&text).unwrap(), None).unwrap();
+        assert_eq!(back, p);
+        let mut bad: serde_json::Value = serde_json::from_str(&text).unwrap();
+        bad["torso_m"] = serde_json::json!([0.3, 0.2]);
+        let e = phantom_params_from_json(&bad, None).unwrap_err();
+        assert!(e.contains("torso_m"), "{e}");
+    }
 
     #[test]
     fn default_is_the_paper_protocol() {

@@ -9,6 +9,8 @@
 //!   `history.csv`, `summary.json`), finished when `done.json` exists (written last,
 //!   atomically); `--resume` skips finished runs and redoes any other run directory from
 //!   scratch;
+//! - `view.json`: the phantom in plan view (outlines, ROI cells, the hand;
+//!   [`surrogate::ViewGeometry`]), which `palpa train` puts beside the model;
 //! - `dataset.npz` + `manifest.json` (also as `dataset.json`, so that both `palpa train DIR` and
 //!   `palpa train DIR/dataset.npz` find it): [`surrogate::Dataset`], written once every run of
 //!   the campaign (or of the shard) is finished. X holds x, y [m], force [N], time [s] and
@@ -288,6 +290,19 @@ fn run_campaign(a: &CampaignArgs) -> Result<(), String> {
         ));
     }
     write_json(&cfile, &desc)?;
+    let view = super::view_geometry::from_phantom(
+        &phantom,
+        &phantom.mesh,
+        super::view_geometry::fingers(campaign.base.finger_spacing, campaign.base.finger_diameter),
+        format!(
+            "campaign `{}` (palpa {})",
+            campaign.title,
+            env!("CARGO_PKG_VERSION")
+        ),
+    )?;
+    let vpath = out.join("view.json");
+    view.write(&vpath)
+        .map_err(|e| format!("{}: {e}", vpath.display()))?;
 
     let todo: Vec<&PlannedRun> = mine
         .iter()
@@ -817,6 +832,18 @@ fn merge(dirs: &[PathBuf], out: &Path, quiet: bool) -> Result<(), String> {
         ));
     }
     write_json(&out.join(CAMPAIGN_FILE), &campaign_file(&plan, None))?;
+    // the plan view of the campaign's phantom, from a shard that has it
+    let view = out.join("view.json");
+    if !view.is_file() {
+        if let Some(src) = dirs
+            .iter()
+            .map(|d| d.join("view.json"))
+            .find(|v| v.is_file())
+        {
+            let bytes = std::fs::read(&src).map_err(|e| format!("{}: {e}", src.display()))?;
+            write_atomic(&view, &bytes)?;
+        }
+    }
     let ds = assemble(&plan, &labels, |l| run_dir(out, l))?;
     write_dataset(&ds, out)?;
     if !quiet {

@@ -1,6 +1,7 @@
 //! Command-line parsing and dispatch.
 
 mod bench;
+mod calibrate;
 mod campaign;
 mod check;
 mod evaluate;
@@ -14,6 +15,7 @@ mod study;
 mod train;
 mod units;
 mod verify;
+mod view_geometry;
 
 use clap::{Parser, Subcommand};
 use std::path::PathBuf;
@@ -100,6 +102,13 @@ enum Command {
     /// Predict the ROI stress [Pa] with a saved surrogate for a finger at x, y [m] pressing with
     /// a force [N], optionally rendering the map; or stream JSON lines with --stdin.
     Predict(predict::PredictArgs),
+    /// The live training view: serve a web page that draws the model's liver stress under the
+    /// trainee's fingers (pointer, force plate over WebSocket or stdin, or a replayed sensor
+    /// log), on localhost:8080 by default.
+    Serve(crate::serve::ServeArgs),
+    /// Fit the force plate's map to the body from presses recorded at known body points (a
+    /// sensor log CSV with x_m, y_m); write calibration.json for `palpa serve --calibration`.
+    Calibrate(calibrate::CalibrateArgs),
     /// Leave-one-location-out cross-validation of each surrogate type and size, and the
     /// accuracy-versus-cost table (Fit, training time, prediction latency).
     Evaluate(evaluate::EvaluateArgs),
@@ -165,6 +174,8 @@ pub fn dispatch(cli: Cli) -> Result<(), String> {
         Command::Verify { hard, out } => verify::verify(hard, &out),
         Command::Train(a) => train::train(&a),
         Command::Predict(a) => predict::predict(&a),
+        Command::Serve(a) => crate::serve::serve(&a),
+        Command::Calibrate(a) => calibrate::calibrate(&a),
         Command::Evaluate(a) => evaluate::run(&a),
         Command::Bench {
             cases,

@@ -6,7 +6,9 @@
 //! - `probe.csv` / `probe_stress.csv`: the ROI's stresses every 5 ms;
 //! - `roi_stress.csv`: per ROI element its centroid and maximum principal stress at each sample;
 //! - `roi.csv`, `locations.json`: the ROI and the palpation locations of the phantom;
-//! - `force_indentation.png` and `roi_stress_map.png`.
+//! - `force_indentation.png` and `roi_stress_map.png` (the ROI's maximum principal stress at the
+//!   end of the press in plan view, with the phantom's outlines and the fingers, drawn as
+//!   `palpa serve` draws a prediction: [`surrogate::render_picture`]).
 
 use super::run::{print_summary, run_loaded};
 use super::units;
@@ -148,6 +150,23 @@ pub fn palpate(args: &PalpateArgs) -> Result<(), String> {
         ph.locations.to_json().as_bytes(),
     )?;
     let centroids = ph.roi.centroids.clone();
+    let view = super::view_geometry::from_phantom(
+        ph,
+        &scene.sim.model.mesh,
+        super::view_geometry::fingers(setup.finger_spacing, setup.finger_diameter),
+        format!("palpa palpate: {}", setup.title),
+    )?;
+    let at = match &setup.place {
+        Place::At(x, y) => [*x, *y],
+        Place::Named(n) => {
+            let l = ph
+                .locations
+                .get(n)
+                .ok_or_else(|| format!("location {n}: the phantom has no such location"))?;
+            [l.surface[0], l.surface[1]]
+        }
+    };
+    let voxel_mm = setup.voxel * 1e3;
     if !args.quiet {
         println!(
             "{}: {} voxel {:.1} mm: {} hexahedra, {} nodes, ROI {} elements; built in {:.2} s",
@@ -163,7 +182,15 @@ pub fn palpate(args: &PalpateArgs) -> Result<(), String> {
     let (summary, err) = run_loaded(&mut scene, out, args.quiet);
     print_summary(&summary);
     // Post-processing also for a failed run: what was written stays usable.
-    let post = postprocess(out, &centroids);
+    let picture = MapSetup {
+        view: &view,
+        at,
+        subtitle: format!(
+            "ROI maximum principal stress [kPa], palpa solver ({} phantom, {voxel_mm:.1} mm voxels), end of the press",
+            setup.variant
+        ),
+    };
+    let post = postprocess(out, &centroids, &picture);
     match (&post, &err) {
         (Ok(p), _) => {
             println!(
@@ -193,8 +220,16 @@ struct Post {
     stress_max: f64,
 }
 
+/// What the stress map shows besides the stresses.
+struct MapSetup<'a> {
+    view: &'a surrogate::ViewGeometry,
+    /// The hand's position (x, y) [m].
+    at: [f64; 2],
+    subtitle: String,
+}
+
 /// Write `roi_stress.csv` and the two plots; return the headline figures.
-fn postprocess(out: &Path, centroids: &[[f64; 3]]) -> Result<Post, String> {
+fn postprocess(out: &Path, centroids: &[[f64; 3]], map: &MapSetup) -> Result<Post, String> {
     let (cols, rows) = read_history(&out.join("history.csv"))?;
     let travel = column(&cols, &rows, "hand_travel").ok_or("history.csv has no hand_travel")?;
     let force = column(&cols, &rows, "hand_reaction").ok_or("history.csv has no hand_reaction")?;
@@ -233,7 +268,22 @@ fn postprocess(out: &Path, centroids: &[[f64; 3]]) -> Result<Post, String> {
     if let Some(last) = probe.stress.last() {
         if !last.is_empty() && last.len() == centroids.len() {
             let c = ndarray::Array2::from_shape_fn((centroids.len(), 3), |(i, j)| centroids[i][j]);
-            surrogate::render_map(c.view(), last, &out.join("roi_stress_map.png"))
+            let picture = surrogate::Picture {
+                values: last,
+                centroids: c.view(),
+                view: Some(map.view),
+                scale: surrogate::ColourScale::of_values(last),
+                hand: Some(surrogate::Hand {
+                    x: map.at[0],
+                    y: map.at[1],
+                    force: probe.force.last().copied().unwrap_or(0.0),
+                }),
+                time_s: probe.time.last().copied(),
+                hull: None,
+                subtitle: map.subtitle.clone(),
+                warnings: Vec::new(),
+            };
+            surrogate::render_picture(&picture, &out.join("roi_stress_map.png"))
                 .map_err(|e| format!("roi_stress_map.png: {e}"))?;
         }
     }

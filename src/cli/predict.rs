@@ -5,8 +5,12 @@
 //! in newtons; outputs are the maximum principal stress of each ROI element in pascals.
 //!
 //! - One-shot: prints the ROI stress vector (one `element_id stress_Pa` line per ROI element,
-//!   after a header), the GP's predictive standard deviation when the model is a GP, and with
-//!   `--png` renders the 2-D map of the ROI stress ([`surrogate::render_map`]).
+//!   after a header), the GP's predictive standard deviation when the model is a GP, what about
+//!   the input lies outside the model's training (outside the body, the training locations'
+//!   hull or force range, a large deviation), and with `--png` renders the picture of the ROI
+//!   stress ([`surrogate::render_picture`]): in plan view with the outlines of `view.json`
+//!   beside the model, the fingers, a title with x, y and the force, and a fixed colour scale
+//!   over the training stress range (the live view's, `palpa serve`).
 //! - `--stdin`, for a live device loop: reads one JSON object per line,
 //!   `{"x": 0.04, "y": 0.05, "force": 20.0}` (an optional `"id"` of any JSON type is echoed back),
 //!   and writes one JSON line per input line, flushed at once:
@@ -21,7 +25,7 @@ use std::fmt::Write as _;
 use std::io::{BufRead, Write};
 use std::path::{Path, PathBuf};
 use surrogate::model::model_paths;
-use surrogate::Predictor;
+use surrogate::{Predictor, ServedModel};
 
 /// `palpa predict`'s arguments. Units are SI: x and y in metres, force in newtons, stress out
 /// in pascals.
@@ -62,9 +66,8 @@ pub fn predict(a: &PredictArgs) -> Result<(), String> {
     }
 }
 
-/// A model path that does not exist gets a message naming it and saying what is expected;
-/// otherwise the model is loaded.
-pub fn load_model(path: &Path) -> Result<Predictor, String> {
+/// A model path that does not exist gets a message naming it and saying what is expected.
+fn check_model_path(path: &Path) -> Result<(), String> {
     let (st, js) = model_paths(path);
     if !path.exists() && !st.exists() && !js.exists() {
         return Err(format!(
@@ -74,7 +77,19 @@ pub fn load_model(path: &Path) -> Result<Predictor, String> {
             path.display()
         ));
     }
+    Ok(())
+}
+
+/// Loads the model at `path` (see [`check_model_path`]).
+pub fn load_model(path: &Path) -> Result<Predictor, String> {
+    check_model_path(path)?;
     Predictor::load(path).map_err(|e| format!("model {}: {e}", path.display()))
+}
+
+/// Loads the model at `path` with its plan geometry and training domain.
+pub fn load_served(path: &Path) -> Result<ServedModel, String> {
+    check_model_path(path)?;
+    ServedModel::load(path).map_err(|e| format!("model {}: {e}", path.display()))
 }
 
 /// One input value, which must be a finite number.
@@ -97,10 +112,10 @@ pub fn predict_one(
     let x = check_finite("--x", x)?;
     let y = check_finite("--y", y)?;
     let force = check_finite("--force", force)?;
-    let mut p = load_model(model)?;
-    let meta = p.meta().clone();
-    let (stress, variance) = p.predict_with_variance(x, y, force);
-    let stress = stress.to_vec();
+    let mut served = load_served(model)?;
+    let meta = served.predictor.meta().clone();
+    let prediction = served.predict(x, y, force);
+    let stress = &prediction.stress;
     let mut text = format!(
         "{} model {} on the {} target ({}): {} ROI elements\nfinger at x = {x} m, y = {y} m, force = {force} N\n",
         meta.kind,
@@ -109,24 +124,45 @@ pub fn predict_one(
         meta.report.size,
         stress.len()
     );
-    if let Some(v) = variance {
+    if let Some(sd) = prediction.sd {
         let of = match meta.report.target {
             surrogate::Target::Principal => "all ROI elements",
             surrogate::Target::Tensor => "every stress component of every ROI element",
         };
-        let _ = writeln!(
-            text,
-            "GP predictive standard deviation ({of}): {:.6e} Pa",
-            v.max(0.0).sqrt()
-        );
+        let _ = writeln!(text, "GP predictive standard deviation ({of}): {sd:.6e} Pa");
+    }
+    for w in &prediction.warnings {
+        let _ = writeln!(text, "warning: {w}");
     }
     if let Some(path) = png {
-        surrogate::render_map(p.roi_centroids(), &stress, path)
+        let scale = served
+            .scale()
+            .unwrap_or_else(|| surrogate::ColourScale::of_values(stress));
+        let scale_note = if served.scale().is_some() {
+            "scale: training range"
+        } else {
+            "scale: this prediction's range (the model records no training range)"
+        };
+        let picture = surrogate::Picture {
+            values: stress,
+            centroids: served.predictor.roi_centroids(),
+            view: served.view.as_ref(),
+            scale,
+            hand: Some(surrogate::Hand { x, y, force }),
+            time_s: None,
+            hull: served.domain().map(|d| d.hull.as_slice()),
+            subtitle: format!(
+                "ROI maximum principal stress [kPa]: {} surrogate ({} target), {scale_note}",
+                meta.kind, meta.report.target
+            ),
+            warnings: prediction.warnings.iter().map(|w| w.to_string()).collect(),
+        };
+        surrogate::render_picture(&picture, path)
             .map_err(|e| format!("--png {}: {e}", path.display()))?;
         let _ = writeln!(text, "map: {}", path.display());
     }
     text.push_str("ROI maximum principal stress [Pa]:\nelement_id stress_Pa\n");
-    for (id, s) in meta.roi_ids.iter().zip(&stress) {
+    for (id, s) in meta.roi_ids.iter().zip(stress) {
         let _ = writeln!(text, "{id} {s:.6e}");
     }
     let mut out = std::io::stdout().lock();

@@ -5,7 +5,9 @@
 //!
 //! Training, scoring and saving are [`surrogate::train`]'s; this module only maps the command
 //! line onto [`surrogate::TrainOptions`] and checks the paths first, so that a wrong path gets a
-//! message naming it.
+//! message naming it. Beside the model it writes the plan-view geometry (`view.json`, see
+//! [`super::view_geometry`]) when the dataset comes from a phantom, so that the model can be
+//! drawn and served without the solver.
 
 use surrogate::mlp::{AdamOptions, GdxOptions, Optimiser};
 use surrogate::model::model_paths;
@@ -204,5 +206,29 @@ pub fn train(a: &TrainArgs) -> Result<(), String> {
     println!("training time: {:.2} s", report.train_seconds);
     let (st, js) = model_paths(&a.out);
     println!("saved {} and {}", st.display(), js.display());
+    write_view(&a.dataset, &a.out)
+}
+
+/// The dataset's plan-view geometry beside the model at `model`, if it has one.
+fn write_view(dataset: &Path, model: &Path) -> Result<(), String> {
+    let t0 = std::time::Instant::now();
+    match super::view_geometry::for_dataset(dataset)? {
+        Some(view) => {
+            let path = surrogate::view::view_path(model);
+            view.write(&path)
+                .map_err(|e| format!("{}: {e}", path.display()))?;
+            println!(
+                "saved {} (plan geometry: {} liver and {} rib outline(s), {} ROI cells; {:.1} s)",
+                path.display(),
+                view.liver.len(),
+                view.ribs.len(),
+                view.roi_cells.len(),
+                t0.elapsed().as_secs_f64()
+            );
+        }
+        None => println!(
+            "no plan geometry: the dataset names no phantom (predict --png draws the ROI alone)"
+        ),
+    }
     Ok(())
 }

@@ -1,6 +1,7 @@
 //! The functions the `palpa train`, `palpa predict` and `palpa evaluate` commands call.
 
 use crate::dataset::Dataset;
+use crate::domain::TrainingDomain;
 use crate::error::{Error, Result};
 use crate::fit::{compute_fit, compute_fit_by_location};
 use crate::gp::{fit_gp, GpOptions};
@@ -49,8 +50,8 @@ pub struct ModelConfig {
 }
 
 /// Reads the dataset at `dataset` (see `Dataset::read`), trains a `kind` model on its split-0
-/// samples, scores it on its split-1 samples, saves it at `out` (see `model::model_paths`) and
-/// returns the report (Fit per test location and overall, training time, latency).
+/// samples, scores it on its split-1 samples, saves it at `out` (see `model::model_paths`) with
+/// its training domain ([`TrainingDomain`]) and returns the report (Fit per test location and overall, training time, latency).
 pub fn train(
     dataset: &Path,
     kind: ModelKind,
@@ -59,11 +60,12 @@ pub fn train(
 ) -> Result<TrainReport> {
     let data = Dataset::read(dataset)?;
     let (model, report) = train_model(&data, kind, opts)?;
-    model.save(
+    model.save_with_domain(
         out,
         data.roi_ids.as_slice().unwrap_or(&data.roi_ids.to_vec()),
         data.roi_centroids.view(),
         &report,
+        TrainingDomain::of_training_rows(&data).as_ref(),
     )?;
     Ok(report)
 }

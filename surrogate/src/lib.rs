@@ -15,16 +15,28 @@
 //!   largest eigenvalue ([`principal`]) it reports.
 //! - [`fit`]: paper eq. 5, per location and overall.
 //! - [`model`]: safetensors + JSON model files and the serving [`Predictor`].
-//! - [`api`]: [`train`], [`predict`], [`evaluate`] for the command line; [`render_map`] for PNG maps.
+//! - [`api`]: [`train`], [`predict`], [`evaluate`] for the command line.
+//! - [`domain`]: what a model was trained on (recorded in `model.json`) and whether an input
+//!   lies outside it.
+//! - [`view`]: the plan-view geometry that travels with a model (`view.json`).
+//! - [`colour`] and [`render`]: the colour scale and the stress picture as a PNG
+//!   ([`render_picture`]).
+//! - [`serving`]: a model with its geometry and domain, as `palpa predict --png` and
+//!   `palpa serve` show it ([`ServedModel`]).
+//! - [`sensor`]: the live inputs of `palpa serve`: the force plate's four load cells, its
+//!   calibration to the body, the force filter and recorded sensor logs.
 //!
 //! It depends on no other palpa crate.
 
 #![warn(missing_docs)]
 
 pub mod api;
+pub mod colour;
 pub mod dataset;
+pub mod domain;
 pub mod error;
 pub mod fit;
+pub mod glyphs;
 pub mod gp;
 pub mod kernels;
 pub mod lbfgs;
@@ -35,18 +47,25 @@ pub mod principal;
 pub mod render;
 pub mod report;
 pub mod rng;
+pub mod sensor;
+pub mod serving;
 pub mod synthetic;
 pub mod target;
 pub mod tensor_file;
+pub mod view;
 
 pub use api::{
     default_evaluation_configs, evaluate, predict, train, train_model, ModelConfig, Prediction,
     TrainOptions,
 };
+pub use colour::ColourScale;
 pub use dataset::{Dataset, Manifest};
+pub use domain::TrainingDomain;
 pub use error::{Error, Result};
 pub use fit::{compute_fit, compute_fit_by_location};
 pub use model::{ModelKind, ModelMeta, Predictor, TrainedModel};
-pub use render::render_map;
+pub use render::{render_map, render_picture, Hand, Picture};
 pub use report::{CostRow, EvaluationReport, LocationFit, TrainReport};
+pub use serving::{Served, ServedModel, Warning};
 pub use target::Target;
+pub use view::ViewGeometry;

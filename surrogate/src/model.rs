@@ -17,6 +17,7 @@
 //! maximum principal stresses.
 
 use crate::dataset::write_atomic;
+use crate::domain::TrainingDomain;
 use crate::error::{Error, Result};
 use crate::gp::{GpModel, GpPredictor, SeArd};
 use crate::mlp::{DenseLayer, MlpModel, MlpPredictor};
@@ -97,6 +98,10 @@ pub struct ModelMeta {
     pub kernel: Option<SeArd>,
     /// Training settings and results.
     pub report: TrainReport,
+    /// What the model was trained on (locations, their hull, largest force, stress range);
+    /// absent from models saved before it was recorded.
+    #[serde(default)]
+    pub domain: Option<TrainingDomain>,
 }
 
 /// A model in memory, as training produces it.
@@ -178,6 +183,18 @@ impl TrainedModel {
         roi_ids: &[i64],
         roi_centroids: ArrayView2<f64>,
         report: &TrainReport,
+    ) -> Result<()> {
+        self.save_with_domain(path, roi_ids, roi_centroids, report, None)
+    }
+
+    /// [`TrainedModel::save`], recording the training domain too (`domain` in `model.json`).
+    pub fn save_with_domain(
+        &self,
+        path: impl AsRef<Path>,
+        roi_ids: &[i64],
+        roi_centroids: ArrayView2<f64>,
+        report: &TrainReport,
+        domain: Option<&TrainingDomain>,
     ) -> Result<()> {
         let (st, js) = model_paths(path.as_ref());
         if let Some(dir) = st.parent().filter(|d| !d.as_os_str().is_empty()) {
@@ -275,6 +292,7 @@ impl TrainedModel {
             activation,
             kernel,
             report: report.clone(),
+            domain: domain.cloned(),
         };
         write_tensors(&st, &set)?;
         let text =
@@ -456,6 +474,14 @@ impl Predictor {
             PredictorImpl::Mlp(m) => (m.predict_inputs(&[x, y, force]), None),
         };
         (self.map.apply(raw), var)
+    }
+
+    /// The GP's prior (latent) standard deviation [Pa], `s_y sigma_f`: the deviation it
+    /// predicts far from every training input; `None` for an MLP.
+    pub fn prior_deviation(&self) -> Option<f64> {
+        let k = self.meta.kernel.as_ref()?;
+        let s_y = self.meta.output_scaling.std.first().copied().unwrap_or(1.0);
+        Some(k.signal_variance.max(0.0).sqrt() * s_y)
     }
 
     /// The model's metadata (kind, architecture, training report, ...).

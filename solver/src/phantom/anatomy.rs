@@ -348,6 +348,16 @@ impl Anatomy {
         self.zc + self.b
     }
 
+    /// Height of the torso outline's centre (m): points above it are in the anterior half.
+    pub fn centre_height(&self) -> f64 {
+        self.zc
+    }
+
+    /// Length of the torso, caudal to cranial (m).
+    pub fn length(&self) -> f64 {
+        self.top
+    }
+
     /// Caudal liver shift (m).
     pub fn shift(&self) -> f64 {
         self.shift

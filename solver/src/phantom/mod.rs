@@ -49,6 +49,7 @@
 mod anatomy;
 mod locations;
 mod params;
+pub mod plan;
 mod roi;
 
 pub use anatomy::{Anatomy, BACKGROUND, FLESH, LIVER, RIBS, SPINE, TUMOUR, VISCERA};
@@ -59,6 +60,7 @@ pub use locations::{
 pub use params::{
     GridParams, PhantomParams, RoiParams, Tumour, Variant, DEFAULT_VOXEL, PAPER_VOXEL,
 };
+pub use plan::{plan_view, PlanView, PLAN_STEP};
 pub use roi::{select_roi, surface_elements, Roi};
 
 use rayon::prelude::*;

@@ -1,0 +1,65 @@
+//! `palpa palpate`'s `roi_stress_map.png` draws the live view's picture (issue 27): a quick
+//! coarse press (8 mm voxels, 3 mm in 3 ms), then the map's size, a title in the title band,
+//! and the colour of the largest ROI stress of the last sample (from `roi_stress.csv`) on its
+//! scale, which the cell drawn last (the largest) must show.
+
+use std::process::Command;
+use surrogate::ColourScale;
+
+#[test]
+fn palpate_draws_the_stress_picture() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("p");
+    let o = Command::new(env!("CARGO_BIN_EXE_palpa"))
+        .args([
+            "palpate",
+            "--voxel",
+            "8mm",
+            "--duration",
+            "3ms",
+            "--depth",
+            "3mm",
+            "--sample-interval",
+            "1ms",
+            "--no-vtk",
+            "--quiet",
+            "--out",
+        ])
+        .arg(&out)
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success() && !err.contains("panicked"), "{err}");
+    // the last sample's stresses: the last column of roi_stress.csv
+    let csv = std::fs::read_to_string(out.join("roi_stress.csv")).unwrap();
+    let last: Vec<f64> = csv
+        .lines()
+        .skip(1)
+        .map(|l| l.rsplit(',').next().unwrap().parse().unwrap())
+        .collect();
+    assert!(last.len() > 10);
+    let scale = ColourScale::of_values(&last);
+    let top = last.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+    let want = scale.rgb(top);
+
+    let dec = png::Decoder::new(std::io::BufReader::new(
+        std::fs::File::open(out.join("roi_stress_map.png")).unwrap(),
+    ));
+    let mut r = dec.read_info().unwrap();
+    let mut buf = vec![0; r.output_buffer_size().unwrap()];
+    let info = r.next_frame(&mut buf).unwrap();
+    assert_eq!((info.width, info.height), surrogate::render::SIZE);
+    assert_eq!(info.color_type, png::ColorType::Rgb);
+    let w = info.width as usize;
+    let px = |x: usize, y: usize| &buf[(y * w + x) * 3..(y * w + x) * 3 + 3];
+    let ink = (12..28)
+        .flat_map(|y| (20..600).map(move |x| (x, y)))
+        .filter(|&(x, y)| px(x, y)[0] < 80)
+        .count();
+    assert!(ink > 300, "the title is drawn: {ink} dark pixels");
+    let hot = buf.chunks(3).filter(|p| *p == want).count();
+    assert!(
+        hot >= 20,
+        "the largest stress's colour {want:?} covers {hot} pixels"
+    );
+}
