@@ -1,15 +1,16 @@
 //! Build a [`Scene`] (model, simulation, output plan) from a [`SceneSpec`].
 
 use super::contact_spec::HandScene;
+use super::def::{DtMin, HourglassGuard, PartDef, SceneDef, Setup};
 use super::spec::*;
 use crate::bc::{Constraint, Kinematic, NodalLoad};
 use crate::curve::Curve;
 use crate::element::{BulkViscosity, Formulation, Hourglass, HourglassForm, HourglassModulus};
 use crate::generate::{box_mesh, BoxSpec};
 use crate::mesh::Mesh;
-use crate::model::{MassScaling, Model, Part};
+use crate::model::MassScaling;
 use crate::phantom::Phantom;
-use crate::simulation::{DynamicRelaxation, HourglassLimit, LoopSettings, Simulation};
+use crate::simulation::{DynamicRelaxation, Simulation};
 use material::quantity::Length;
 use material::Material;
 use std::path::{Path, PathBuf};
@@ -61,6 +62,9 @@ pub struct Scene {
     pub phantom: Option<Phantom>,
     /// Things the builder adjusted that the user should know (printed before the run).
     pub notes: Vec<String>,
+    /// What runs on the mesh, as resolved (indenters as they run: hands turned into their
+    /// capsules and placed), for `palpa export`.
+    pub setup: super::def::Setup,
 }
 
 /// A scene error with its location.
@@ -282,11 +286,23 @@ pub fn build_scene(spec: SceneSpec, path: &Path, src: &str) -> Result<Scene, Str
 /// [`build_scene`], reusing an already built phantom when the scene's `[mesh.phantom]` asks
 /// for the same parameters (campaigns build the phantom once for all their runs).
 pub fn build_scene_with(
-    mut spec: SceneSpec,
+    spec: SceneSpec,
     path: &Path,
     src: &str,
     prebuilt: Option<Phantom>,
 ) -> Result<Scene, String> {
+    super::def::assemble(resolve_scene(spec, path, src, prebuilt)?)
+}
+
+/// Resolve a parsed scene to SI ([`SceneDef`]): the mesh with its node sets, the parts' laws,
+/// boundary conditions, loads, settings, output and contact. [`super::def::assemble`] builds
+/// the model from it.
+pub fn resolve_scene(
+    mut spec: SceneSpec,
+    path: &Path,
+    src: &str,
+    prebuilt: Option<Phantom>,
+) -> Result<SceneDef, String> {
     let e = |key: &str, needle: Option<&str>, msg: &dyn std::fmt::Display| {
         err(path, src, key, needle, msg)
     };
@@ -421,9 +437,15 @@ pub fn build_scene_with(
         };
         let formulation =
             formulation(ps).map_err(|m| e(&key, Some(&format!("\"{pname}\"")), &m))?;
-        parts.push(Part {
+        let card = match spec.materials.get(&ps.material) {
+            Some(card) => card.clone(),
+            None => material::library::named(&ps.material)
+                .map_err(|m| e(&format!("{key}.material"), Some(&ps.material), &m))?,
+        };
+        parts.push(PartDef {
             name: pname.clone(),
             material,
+            spec: card,
             formulation,
         });
     }
@@ -528,13 +550,13 @@ pub fn build_scene_with(
             }
         }
     }
-    let mut v0: Option<Vec<[f64; 3]>> = None;
+    let mut initial_velocity = Vec::new();
     for (i, iv) in spec.initial_velocities.iter().enumerate() {
         let nodes = set(&iv.nodes, &format!("initial_velocity[{i}].nodes"))?;
-        let v = v0.get_or_insert_with(|| vec![[0.0; 3]; mesh.nodes.len()]);
-        for n in nodes {
-            v[n as usize] = [iv.velocity[0].0, iv.velocity[1].0, iv.velocity[2].0];
-        }
+        initial_velocity.push((
+            nodes,
+            [iv.velocity[0].0, iv.velocity[1].0, iv.velocity[2].0],
+        ));
     }
     // Output plan.
     let out = &spec.output;
@@ -636,65 +658,62 @@ pub fn build_scene_with(
     let relaxation = spec.relaxation.as_ref().map(|r| DynamicRelaxation {
         tolerance: r.tolerance.map(|x| x.0).unwrap_or(1e-10),
     });
-    let model = Model::build(mesh, parts, mass_scaling, dt_factor)
-        .map_err(|m| format!("{}: {m}", path.display()))?;
-    let dt0 = model.scaled_dt.min(model.initial_dt.0);
-    let settings = LoopSettings {
-        dt_factor,
-        bulk,
-        damping,
-        gravity,
-        relaxation,
-        dt_max: spec.run.dt_max.map(|t| t.0).unwrap_or(f64::INFINITY),
-        dt_min: spec.run.dt_min.map(|t| t.0).unwrap_or(1e-6 * dt0),
-        hourglass_limit: match spec.run.max_hourglass_ratio {
-            Some(r) if !(r.0 > 0.0) => {
-                return Err(format!(
-                    "{}: run.max_hourglass_ratio must be positive (got {})",
-                    path.display(),
-                    r.0
-                ))
-            }
-            Some(r) => Some(HourglassLimit {
-                ratio: r.0,
-                after: spec
-                    .run
-                    .hourglass_check_after
-                    .map(|t| t.0)
-                    .unwrap_or(0.1 * end_time),
-            }),
-            None => None,
-        },
+    let hourglass_guard = match spec.run.max_hourglass_ratio {
+        Some(r) if !(r.0 > 0.0) => {
+            return Err(format!(
+                "{}: run.max_hourglass_ratio must be positive (got {})",
+                path.display(),
+                r.0
+            ))
+        }
+        Some(r) => Some(HourglassGuard {
+            ratio: r.0,
+            after: spec.run.hourglass_check_after.map(|t| t.0),
+        }),
+        None => None,
     };
-    let want_stress = plan.needs_stress() || plan.probe.is_some();
-    let mut sim = Simulation::new(model, settings, constraints, loads, v0, want_stress)
-        .map_err(|m| format!("{}: {m}", path.display()))?;
-    let mut notes = Vec::new();
     // Contact exists only when the scene has indenters or hands.
-    if !spec.indenters.is_empty() || !spec.hands.is_empty() {
-        let stage = crate::contact_stage::build_stage(
-            &sim,
+    let contact = if !spec.indenters.is_empty() || !spec.hands.is_empty() {
+        Some(crate::contact_stage::resolve_contact(
+            &mesh,
             &spec.indenters,
             &spec.hands,
             spec.contact.as_ref(),
             path,
             src,
-            &mut notes,
-        )?;
-        sim.stages.push(Box::new(stage));
-    }
-    Ok(Scene {
-        sim,
-        end_time,
+        )?)
+    } else {
+        None
+    };
+    let setup = Setup {
+        parts,
+        constraints,
+        loads,
+        initial_velocity,
+        dt_factor,
+        dt_max: spec.run.dt_max.map(|t| t.0),
+        dt_min: spec.run.dt_min.map(|t| DtMin::Time(t.0)),
+        hourglass_guard,
+        bulk,
+        damping,
+        gravity,
+        relaxation,
+        mass_scaling,
         output: plan,
+        contact,
+    };
+    Ok(SceneDef {
         title: spec.run.title.clone().unwrap_or_else(|| {
             path.file_stem()
                 .map(|s| s.to_string_lossy().into_owned())
                 .unwrap_or_default()
         }),
         path: path.to_path_buf(),
+        end_time,
+        mesh,
         phantom,
-        notes,
+        setup,
+        notes: Vec::new(),
     })
 }
 
