@@ -200,6 +200,24 @@ impl W {
         let u = self.u.clone();
         self.back(v, u.from_si(v, d), move |x| u.to_si(x, d), std)
     }
+    /// A node coordinate: its exact text when one fits (see [`Units::si_text`]), and whether
+    /// it is exact.
+    fn coordinate(&mut self, v: f64) -> (String, bool) {
+        let w = self.width(16);
+        let t = self
+            .u
+            .si_text(v, Dim::LENGTH, w - 1)
+            .or_else(|| self.u.si_text(v, Dim::LENGTH, w));
+        match t {
+            Some(t) => {
+                self.values += 1;
+                (format!("{t:>w$}"), true)
+            }
+            // The reader converts coordinates from their text: without an exact text the
+            // comment carries the value.
+            None => (self.si(v, Dim::LENGTH, 16), false),
+        }
+    }
     /// Write a deck number `x` near `guess` such that `back(x) == target`, if one exists
     /// within a few binary steps and fits the field.
     fn back(&mut self, target: f64, guess: f64, back: impl Fn(f64) -> f64, std: usize) -> String {
@@ -427,6 +445,7 @@ struct CurveOut {
     title: String,
     /// Points in SI with the dimensions of the use.
     points: Vec<(f64, f64)>,
+    xdim: Dim,
     ydim: Dim,
     note: Option<(String, String)>,
 }
@@ -448,18 +467,23 @@ pub fn export(scene: &Scene, opts: &ExportOptions) -> Result<Exported, String> {
     let u = opts.units.clone();
     let end = scene.end_time;
     let mut curves: Vec<CurveOut> = Vec::new();
-    let mut new_curve =
-        |title: &str, points: Vec<(f64, f64)>, ydim: Dim, note: Option<(String, String)>| {
-            let id = curves.len() as i64 + 1;
-            curves.push(CurveOut {
-                id,
-                title: title.to_string(),
-                points,
-                ydim,
-                note,
-            });
-            id
-        };
+    // Curves against time; a material curve's abscissa is a number (`x` dimension NONE).
+    let mut new_curve = |title: &str,
+                         points: Vec<(f64, f64)>,
+                         xdim: Dim,
+                         ydim: Dim,
+                         note: Option<(String, String)>| {
+        let id = curves.len() as i64 + 1;
+        curves.push(CurveOut {
+            id,
+            title: title.to_string(),
+            points,
+            xdim,
+            ydim,
+            note,
+        });
+        id
+    };
     let n_pts = opts.curve_points.max(3);
     // Sample times: round numbers in the deck's time unit (12 significant digits), and the
     // curve evaluated at exactly the time the deck states.
@@ -596,6 +620,7 @@ pub fn export(scene: &Scene, opts: &ExportOptions) -> Result<Exported, String> {
             "largest time step",
             vec![(0.0, dm), (end, dm)],
             Dim::TIME,
+            Dim::TIME,
             None,
         );
     }
@@ -659,6 +684,7 @@ pub fn export(scene: &Scene, opts: &ExportOptions) -> Result<Exported, String> {
                 let lc = new_curve(
                     &format!("gravity {}", axis.to_lowercase()),
                     vec![(0.0, -g[k]), (end, -g[k])],
+                    Dim::TIME,
                     Dim::ACCELERATION,
                     None,
                 );
@@ -804,6 +830,7 @@ pub fn export(scene: &Scene, opts: &ExportOptions) -> Result<Exported, String> {
                         ["x", "y", "z"][c.dof]
                     ),
                     pts,
+                    Dim::TIME,
                     if vel { Dim::VELOCITY } else { Dim::LENGTH },
                     note,
                 );
@@ -826,6 +853,7 @@ pub fn export(scene: &Scene, opts: &ExportOptions) -> Result<Exported, String> {
         let lc = new_curve(
             &format!("force {} per node of set {sid}", ["x", "y", "z"][l.dof]),
             pts,
+            Dim::TIME,
             Dim::FORCE,
             note,
         );
@@ -939,6 +967,7 @@ pub fn export(scene: &Scene, opts: &ExportOptions) -> Result<Exported, String> {
             }
             w.kw("PART");
             w.text_line(&s.name);
+            w.palpa("direction", &tv3(s.direction));
             if tris.is_none() {
                 w.palpa("indenter", &format!("[{}]", exact.join(", ")));
                 notes.push(format!(
@@ -1022,6 +1051,7 @@ pub fn export(scene: &Scene, opts: &ExportOptions) -> Result<Exported, String> {
                 let lc = new_curve(
                     &format!("{} of {}", if vel { "speed" } else { "travel" }, s.name),
                     pts,
+                    Dim::TIME,
                     if vel { Dim::VELOCITY } else { Dim::LENGTH },
                     note,
                 );
@@ -1218,20 +1248,26 @@ pub fn export(scene: &Scene, opts: &ExportOptions) -> Result<Exported, String> {
         let cells = [w.int(c.id, 10)];
         w.card(&cells);
         for &(t, v) in &c.points {
-            let cells = [w.si(t, Dim::TIME, 20), w.si(v, c.ydim, 20)];
+            let cells = [w.si(t, c.xdim, 20), w.si(v, c.ydim, 20)];
             w.card(&cells);
         }
     }
 
     // Nodes and elements.
     w.kw("NODE");
+    // A node whose coordinates do not all fit their 20 columns exactly (a few near zero need
+    // 21 characters) gets its exact coordinates in a comment before it.
     let node_line = |w: &mut W, id: i64, x: [f64; 3]| {
-        let cells = [
-            w.int(id, 8),
-            w.si(x[0], Dim::LENGTH, 16),
-            w.si(x[1], Dim::LENGTH, 16),
-            w.si(x[2], Dim::LENGTH, 16),
-        ];
+        let mut cells = vec![w.int(id, 8)];
+        let mut exact = true;
+        for &c in &x {
+            let (t, ok) = w.coordinate(c);
+            exact &= ok;
+            cells.push(t);
+        }
+        if !exact {
+            w.palpa(&format!("n{id}"), &tv3(x));
+        }
         w.card(&cells);
     };
     for (i, &x) in mesh.nodes.iter().enumerate() {
@@ -1518,7 +1554,7 @@ fn write_material(
     pid: i64,
     p: &solver::scene::def::PartDef,
     notes: &mut Vec<String>,
-    new_curve: &mut impl FnMut(&str, Vec<(f64, f64)>, Dim, Option<(String, String)>) -> i64,
+    new_curve: &mut impl FnMut(&str, Vec<(f64, f64)>, Dim, Dim, Option<(String, String)>) -> i64,
 ) -> Result<(), String> {
     let m = &p.material;
     let card = card_toml(&p.spec, m);
@@ -1627,12 +1663,12 @@ fn write_material(
                 }
                 material::foam::UniaxialCurve::NeoHookean(g) => {
                     notes.push(format!(
-                        "part `{}`: simplified_rubber without a curve (palpa's neo-Hookean P = G (l - 1/l^2)) tabulated for LS-DYNA at 161 stretches from 0.2 to 3.2; palpa reads its exact curve from a $palpa comment",
+                        "part `{}`: simplified_rubber without a curve (palpa's neo-Hookean P = G (l - 1/l^2)) tabulated for LS-DYNA at 121 stretches from 0.2 to 3.2 (step 0.025); palpa reads its exact curve from a $palpa comment",
                         p.name
                     ));
-                    (0..=160)
+                    (0..=120)
                         .map(|k| {
-                            let l = 0.2 + 3.0 * k as f64 / 160.0;
+                            let l = (8 + k) as f64 / 40.0;
                             (l, g * (l - 1.0 / (l * l)))
                         })
                         .collect()
@@ -1642,6 +1678,7 @@ fn write_material(
             let lc = new_curve(
                 &format!("{}: nominal stress against dl (SGL = SW = ST = 1)", p.name),
                 pts.iter().map(|&(l, s)| (l - 1.0, s)).collect(),
+                Dim::NONE,
                 Dim::PRESSURE,
                 None,
             );
@@ -1675,6 +1712,7 @@ fn write_material(
                 new_curve(
                     &format!("{}: yield stress against effective plastic strain", p.name),
                     h.iter().map(|(e, y)| (e.0, y.0)).collect(),
+                    Dim::NONE,
                     Dim::PRESSURE,
                     None,
                 )

@@ -31,6 +31,8 @@ pub struct NodeCard {
     pub id: i64,
     /// Coordinates (deck units).
     pub x: [f64; 3],
+    /// Coordinates as written (converted to SI from the text, see [`crate::units::Units::to_si_text`]).
+    pub text: [Box<str>; 3],
     /// Translational constraint code TC (0 none, 1 x, 2 y, 3 z, 4 xy, 5 yz, 6 zx, 7 all).
     pub tc: i64,
     /// Where.
@@ -482,6 +484,8 @@ pub struct Deck {
     pub errors: Vec<String>,
     /// `$palpa:` comments before the first keyword.
     pub header_palpa: Vec<(Loc, String)>,
+    /// `$palpa:` comments of the `*NODE` blocks (exact coordinates of nodes that did not fit).
+    pub node_palpa: Vec<(Loc, String)>,
 }
 
 /// Cards of a block, read in order.
@@ -1109,11 +1113,13 @@ fn parse_block(d: &mut Deck, b: &Block) -> Result<(), String> {
             d.title = Some(c.title());
         }
         "NODE" => {
+            d.node_palpa.extend(b.palpa.iter().cloned());
             for card in c.rest() {
                 let f = fields(b, Some(card), NODE)?;
                 d.nodes.push(NodeCard {
                     id: f.int_req("NID")?,
                     x: [f.real("X", 0.0)?, f.real("Y", 0.0)?, f.real("Z", 0.0)?],
+                    text: [f.raw("X").into(), f.raw("Y").into(), f.raw("Z").into()],
                     tc: f.int("TC", 0)?,
                     at: card.at.clone(),
                 });

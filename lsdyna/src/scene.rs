@@ -40,6 +40,7 @@ use contact::{ContactParams, IndenterSpec, MotionSpec, PenaltyKind, ShapeSpec};
 use material::quantity::{Density, Dim, Number, Pressure, Rate};
 use material::spec::{FoamSpec, IsotropicSpec, OgdenSpec, PlasticitySpec, PronySpec};
 use material::{Material, MaterialSpec};
+use serde::Deserialize;
 use solver::bc::{Constraint, Kinematic, NodalLoad};
 use solver::curve::Curve;
 use solver::element::{BulkViscosity, Formulation, Hourglass, HourglassForm, HourglassModulus};
@@ -491,11 +492,41 @@ fn build(cx: &mut Ctx, path: &Path) -> Result<SceneDef, Vec<String>> {
     for (i, n) in d.nodes.iter().enumerate() {
         if used[i] {
             palpa_node[i] = Some(mesh.nodes.len() as u32);
-            mesh.nodes.push([
-                cx.si(n.x[0], Dim::LENGTH),
-                cx.si(n.x[1], Dim::LENGTH),
-                cx.si(n.x[2], Dim::LENGTH),
-            ]);
+            mesh.nodes.push(std::array::from_fn(|k| {
+                cx.u.to_si_text(&n.text[k], Dim::LENGTH)
+                    .unwrap_or_else(|| cx.si(n.x[k], Dim::LENGTH))
+            }));
+        }
+    }
+    // Exact coordinates from `$palpa: n<ID> = [x, y, z]` comments, when within 1e-9 of the
+    // mesh size of the card's.
+    if let Some(t) = cx.comments(&d.node_palpa.clone()) {
+        let (lo, hi) = mesh.bounds();
+        let size = (0..3).map(|k| hi[k] - lo[k]).fold(0.0, f64::max);
+        let at = d.node_palpa[0].0.clone();
+        let mut bad = 0;
+        for (k, v) in t {
+            let id = k.strip_prefix('n').and_then(|x| x.parse::<i64>().ok());
+            let x: Option<[f64; 3]> = <[f64; 3]>::deserialize(v).ok();
+            match (id.and_then(|i| node_index.get(&i)), x) {
+                (Some(&i), Some(x)) => match palpa_node[i] {
+                    Some(p) => {
+                        let q = &mut mesh.nodes[p as usize];
+                        if (0..3).all(|c| (q[c] - x[c]).abs() <= 1e-9 * size) {
+                            *q = x;
+                        } else {
+                            bad += 1;
+                        }
+                    }
+                    None => {}
+                },
+                _ => bad += 1,
+            }
+        }
+        if bad > 0 {
+            cx.warn.push(format!(
+                "{at}: {bad} `$palpa: n<ID>` node comment(s) ignored (no such node, or not where the card puts it)"
+            ));
         }
     }
     let mut rigid_node = vec![false; d.nodes.len()];
@@ -1848,12 +1879,11 @@ fn indenter(
     let vid = |deck_node: i64, local: &mut HashMap<usize, u32>, verts: &mut Vec<[f64; 3]>| {
         let i = node_index[&deck_node];
         *local.entry(i).or_insert_with(|| {
-            let x = d.nodes[i].x;
-            verts.push([
-                cx.u.to_si(x[0], Dim::LENGTH),
-                cx.u.to_si(x[1], Dim::LENGTH),
-                cx.u.to_si(x[2], Dim::LENGTH),
-            ]);
+            let n = &d.nodes[i];
+            verts.push(std::array::from_fn(|k| {
+                cx.u.to_si_text(&n.text[k], Dim::LENGTH)
+                    .unwrap_or_else(|| cx.u.to_si(n.x[k], Dim::LENGTH))
+            }));
             (verts.len() - 1) as u32
         })
     };
@@ -2052,6 +2082,21 @@ fn indenter(
             ))
         }
     };
+    // The exact direction from the comment, when it is the deck's (to 1e-9 rad).
+    let mut direction = direction;
+    if let Some(exact) = annotate::take::<[f64; 3]>(&mut t, "direction", &p.card.at, &mut cx.warn) {
+        let n = |v: [f64; 3]| (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]).sqrt();
+        let (a, b) = (n(exact), n(direction));
+        let c =
+            (exact[0] * direction[0] + exact[1] * direction[1] + exact[2] * direction[2]) / (a * b);
+        if a > 0.0 && b > 0.0 && c > 1.0 - 1e-15 {
+            direction = exact;
+        } else if !matches!(motion, MotionSpec::Fixed) {
+            cx.warn.push(format!(
+                "{here}: `$palpa: direction` is not the direction of its prescribed motion; the deck's is used"
+            ));
+        }
+    }
     cx.mapping.push(format!(
         "rigid part {} as indenter `{name}`: {shape_note}; {how}",
         p.card.id

@@ -189,6 +189,70 @@ impl Units {
         self.factor(d).from_si(v)
     }
 
+    /// A deck number given as text, in SI. With a power-of-ten factor the power is added to
+    /// the number's decimal exponent before it is parsed, so the decimal is rounded to binary
+    /// once: the text the writer derives from an SI value ([`Units::si_text`]) reads back as
+    /// exactly that value. `None` when the text is not a number.
+    pub fn to_si_text(&self, s: &str, d: Dim) -> Option<f64> {
+        let t = s.trim().replace(['d', 'D'], "e");
+        if t.is_empty() {
+            return Some(0.0);
+        }
+        match self.factor(d) {
+            Factor::Pow10(k) => {
+                let (m, e) = match t.find(['e', 'E']) {
+                    Some(i) => (&t[..i], t[i + 1..].parse::<i32>().ok()?),
+                    None => (t.as_str(), 0),
+                };
+                m.parse::<f64>().ok()?;
+                format!("{m}e{}", e + k).parse::<f64>().ok()
+            }
+            Factor::Mul(f) => t.parse::<f64>().ok().map(|v| v * f),
+        }
+    }
+
+    /// The shortest text of the SI value `v` in this system that [`Units::to_si_text`] reads
+    /// back as exactly `v`, within `room` characters (plain, exponent, or integer mantissa
+    /// with exponent); `None` when none fits or the factor is not a power of ten.
+    pub fn si_text(&self, v: f64, d: Dim, room: usize) -> Option<String> {
+        let Factor::Pow10(k) = self.factor(d) else {
+            return None;
+        };
+        if v == 0.0 {
+            return Some("0.0".into());
+        }
+        let sci = format!("{v:e}");
+        let (m, e) = sci.split_once('e')?;
+        let e: i32 = e.parse::<i32>().ok()? - k;
+        let (sign, m) = m.strip_prefix('-').map_or(("", m), |r| ("-", r));
+        let digits: String = m.chars().filter(|c| *c != '.').collect();
+        let n = digits.len() as i32;
+        let mut cands = vec![
+            format!("{sign}{m}e{e}"),
+            format!("{sign}{digits}e{}", e - (n - 1)),
+        ];
+        // Plain notation: the decimal point after `e + 1` digits.
+        let point = e + 1;
+        if (-6..=21).contains(&point) {
+            let plain = if point <= 0 {
+                format!("{sign}0.{}{digits}", "0".repeat((-point) as usize))
+            } else if point >= n {
+                format!("{sign}{digits}{}.", "0".repeat((point - n) as usize))
+            } else {
+                format!(
+                    "{sign}{}.{}",
+                    &digits[..point as usize],
+                    &digits[point as usize..]
+                )
+            };
+            cands.insert(0, plain);
+        }
+        cands
+            .into_iter()
+            .filter(|c| c.len() <= room && self.to_si_text(c, d) == Some(v))
+            .min_by_key(|c| c.len())
+    }
+
     /// The unit of dimension `d` in words, for comments (e.g. `GPa`, `kg/mm^3`, `mm/ms`).
     pub fn unit_name(&self, d: Dim) -> String {
         let parts: Vec<&str> = self.name.split('-').collect();
@@ -279,6 +343,21 @@ mod tests {
         let c = Units::from_control_units("mm", "ms", "kg").unwrap();
         assert!(c.same_as(&u));
         assert_eq!(c.control_units_words(), Some(["mm", "ms", "kg"]));
+        // Text conversion is exact: any SI value's text in mm reads back to the same bits.
+        for v in [
+            0.12000014565012436,
+            -8.000000025919015e-3,
+            4.650668556969104e-18,
+            0.06,
+        ] {
+            let t = u.si_text(v, Dim::LENGTH, 20).unwrap();
+            assert_eq!(u.to_si_text(&t, Dim::LENGTH), Some(v), "{t}");
+        }
+        assert_eq!(
+            u.si_text(0.12000014565012436, Dim::LENGTH, 20).unwrap(),
+            "120.00014565012436"
+        );
+        assert_eq!(u.to_si_text("1.5d-3", Dim::LENGTH), Some(1.5e-6));
         let imp = Units::from_control_units("in", "sec", "slinch").unwrap();
         // slinch-in-s: a force unit of 1 lbf = 4.4482216152605 N
         assert!((imp.to_si(1.0, Dim::FORCE) - 4.448_221_615_260_5).abs() < 1e-12);
