@@ -1036,6 +1036,9 @@ const OUTPUT_ONLY: &[&str] = &[
     "CONTROL_STRUCTURED",
     "CONTROL_REPORT",
     "CONTROL_ACCURACY",
+    "CONTROL_SOLID",
+    "CONTROL_SHELL",
+    "CONTROL_RIGID",
     "COMMENT",
     "TITLE",
     "DEFINE_CURVE_TITLE",
@@ -1677,10 +1680,16 @@ fn parse_block(d: &mut Deck, b: &Block) -> Result<(), String> {
         }
         _ => {
             if OUTPUT_ONLY.iter().any(|p| name.starts_with(p)) {
-                d.warnings.push(format!(
-                    "{}: {kw}: ignored (output or bookkeeping palpa does not write; see docs/outputs.md for what it does write)",
-                    b.at
-                ));
+                let why = if name.starts_with("CONTROL_SOLID") {
+                    "options for tetrahedra and degenerate solids; palpa has hexahedra only"
+                } else if name.starts_with("CONTROL_SHELL") || name.starts_with("CONTROL_RIGID") {
+                    "shell and rigid-body options; palpa reads shells and rigid parts only as indenter surfaces"
+                } else if name.starts_with("CONTROL_ACCURACY") {
+                    "palpa's total Lagrangian elements are objective without it"
+                } else {
+                    "output or bookkeeping palpa does not write; docs/outputs.md lists what it writes"
+                };
+                d.warnings.push(format!("{}: {kw}: ignored ({why})", b.at));
             } else {
                 return Err(format!(
                     "{}: {kw} is not supported and would change the model: {}",
