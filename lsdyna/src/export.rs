@@ -613,6 +613,9 @@ pub fn export(scene: &Scene, opts: &ExportOptions) -> Result<Exported, String> {
         w.card(&cells);
     }
     w.kw("CONTROL_TIMESTEP");
+    if let Some(StepTarget::Step(t)) = setup.mass_scaling.map(|m| m.target) {
+        w.palpa("target_dt", &tn(t));
+    }
     let f = setup.dt_factor;
     let mut lctm = 0;
     if let Some(dm) = setup.dt_max {

@@ -385,6 +385,8 @@ pub struct TimestepCard {
     pub dt2msf: f64,
     /// Where.
     pub at: Loc,
+    /// `$palpa:` comments (`target_dt`: the exact mass-scaling step).
+    pub palpa: Vec<(Loc, String)>,
 }
 
 /// `*CONTROL_TERMINATION`.
@@ -442,6 +444,8 @@ pub struct Deck {
     pub timestep: Option<TimestepCard>,
     /// `*CONTROL_BULK_VISCOSITY` (Q1, Q2).
     pub bulk: Option<(f64, f64, Loc)>,
+    /// Its `$palpa:` comments (`bulk_viscosity = false`: off, which LS-DYNA cannot say).
+    pub bulk_palpa: Vec<(Loc, String)>,
     /// `*CONTROL_CONTACT` SLSFAC.
     pub slsfac: Option<(f64, Loc)>,
     /// `*DAMPING_GLOBAL` VALDMP.
@@ -1278,7 +1282,11 @@ fn parse_block(d: &mut Deck, b: &Block) -> Result<(), String> {
         }
         "CONTROL_HOURGLASS" => {
             let f = c.fields(CONTROL_HOURGLASS)?;
-            d.control_hourglass = Some((f.int("IHQ", 1)?, f.real("QH", 0.1)?, b.at.clone()));
+            d.control_hourglass = Some((
+                f.int("IHQ", 1)?,
+                nonzero_or(f.real("QH", 0.1)?, 0.1),
+                b.at.clone(),
+            ));
         }
         "CONTROL_TERMINATION" => {
             let f = c.fields(TERMINATION)?;
@@ -1323,7 +1331,7 @@ fn parse_block(d: &mut Deck, b: &Block) -> Result<(), String> {
                 return Err(g.err("IMSCL", "selective mass scaling (the non-diagonal mass matrix) is not supported; palpa adds lumped mass to small elements (DT2MS < 0)"));
             }
             d.timestep = Some(TimestepCard {
-                tssfac: f.real("TSSFAC", 0.9)?,
+                tssfac: nonzero_or(f.real("TSSFAC", 0.9)?, 0.9),
                 dt2ms: f.real("DT2MS", 0.0)?,
                 lctm: match f.int("LCTM", 0)? {
                     0 => None,
@@ -1331,6 +1339,7 @@ fn parse_block(d: &mut Deck, b: &Block) -> Result<(), String> {
                 },
                 dt2msf: g.real("DT2MSF", 0.0)?,
                 at: b.at.clone(),
+                palpa: b.palpa.clone(),
             });
         }
         "CONTROL_BULK_VISCOSITY" => {
@@ -1344,7 +1353,13 @@ fn parse_block(d: &mut Deck, b: &Block) -> Result<(), String> {
                     ),
                 ));
             }
-            d.bulk = Some((f.real("Q1", 1.5)?, f.real("Q2", 0.06)?, b.at.clone()));
+            // Zero is LS-DYNA's default (1.5, 0.06), not "off".
+            d.bulk = Some((
+                nonzero_or(f.real("Q1", 1.5)?, 1.5),
+                nonzero_or(f.real("Q2", 0.06)?, 0.06),
+                b.at.clone(),
+            ));
+            d.bulk_palpa = b.palpa.clone();
         }
         "CONTROL_UNITS" => {
             let f = c.fields(UNITS)?;
@@ -1368,7 +1383,7 @@ fn parse_block(d: &mut Deck, b: &Block) -> Result<(), String> {
         }
         "CONTROL_CONTACT" => {
             let f = c.fields(CONTROL_CONTACT)?;
-            d.slsfac = Some((f.real("SLSFAC", 0.1)?, b.at.clone()));
+            d.slsfac = Some((nonzero_or(f.real("SLSFAC", 0.1)?, 0.1), b.at.clone()));
             warn_fields(
                 d,
                 &f,
@@ -1412,7 +1427,7 @@ fn parse_block(d: &mut Deck, b: &Block) -> Result<(), String> {
                     _ => 2,
                 },
                 lcid: key(f.raw("LCID")),
-                sf: f.real("SF", 1.0)?,
+                sf: nonzero_or_one(f.real("SF", 1.0)?),
                 at: b.at.clone(),
             });
         }
@@ -1702,12 +1717,17 @@ fn parse_block(d: &mut Deck, b: &Block) -> Result<(), String> {
     Ok(())
 }
 
-fn nonzero_or_one(x: f64) -> f64 {
+/// LS-DYNA reads 0 in most real fields as "the default".
+fn nonzero_or(x: f64, default: f64) -> f64 {
     if x == 0.0 {
-        1.0
+        default
     } else {
         x
     }
+}
+
+fn nonzero_or_one(x: f64) -> f64 {
+    nonzero_or(x, 1.0)
 }
 
 fn parse_mat(d: &mut Deck, b: &Block) -> Result<(), String> {

@@ -873,7 +873,19 @@ fn build(cx: &mut Ctx, path: &Path) -> Result<SceneDef, Vec<String>> {
                 t.dt2msf
             ));
         } else if t.dt2ms < 0.0 {
-            let target = t.tssfac * cx.si(-t.dt2ms, Dim::TIME);
+            let mut target = t.tssfac * cx.si(-t.dt2ms, Dim::TIME);
+            let mut note = cx.comments(&t.palpa.clone());
+            if let Some(exact) = annotate::take::<f64>(&mut note, "target_dt", &t.at, &mut cx.warn)
+            {
+                if (exact - target).abs() <= 1e-9 * target {
+                    target = exact;
+                } else {
+                    cx.warn.push(format!(
+                        "{}: `$palpa: target_dt` is not TSSFAC |DT2MS|; the deck's step is used",
+                        t.at
+                    ));
+                }
+            }
             mass_scaling = Some(StepTarget::Step(target));
             cx.mapping.push(format!(
                 "mass scaling: elements whose step falls below TSSFAC |DT2MS| = {target:.4e} s get mass"
@@ -910,14 +922,25 @@ fn build(cx: &mut Ctx, path: &Path) -> Result<SceneDef, Vec<String>> {
         .map(|t| t.dtmin)
         .filter(|&f| f > 0.0)
         .map(DtMin::Factor);
-    let bulk = match &d.bulk {
+    let mut bulk = match &d.bulk {
         None => Some(BulkViscosity::default()),
-        Some((q1, q2, _)) if *q1 == 0.0 && *q2 == 0.0 => None,
         Some((q1, q2, _)) => Some(BulkViscosity {
             quadratic: *q1,
             linear: *q2,
         }),
     };
+    if let Some((q1, q2, at)) = &d.bulk {
+        let mut t = cx.comments(&d.bulk_palpa.clone());
+        if annotate::take::<bool>(&mut t, "bulk_viscosity", at, &mut cx.warn) == Some(false) {
+            if *q1 <= 1e-6 && *q2 <= 1e-6 {
+                bulk = None;
+            } else {
+                cx.warn.push(format!(
+                    "{at}: `$palpa: bulk_viscosity = false` ignored: Q1 and Q2 are not near zero"
+                ));
+            }
+        }
+    }
     // Per-part bulk viscosity of *HOURGLASS cards must agree with the global one.
     for p in &d.parts {
         if let Some(h) = d.hourglass.get(&p.hourglass) {
@@ -1199,14 +1222,7 @@ fn part_def(cx: &mut Ctx, p: &PartInfo, name: &str) -> Result<PartDef, String> {
     if let Some(card) = annotate::take::<MaterialSpec>(&mut t, "card", &m.at, &mut cx.warn) {
         match card.build_in(name, None) {
             Ok(exact) => {
-                let close = |a: f64, b: f64| (a - b).abs() <= 1e-3 * a.abs().max(b.abs());
-                if close(exact.density(), material.density())
-                    && close(
-                        exact.initial_shear_modulus(),
-                        material.initial_shear_modulus(),
-                    )
-                    && close(exact.initial_wave_speed(), material.initial_wave_speed())
-                {
+                if describes(&exact, &material) {
                     law_note = format!(
                         "{} (palpa's own card from the `$palpa: card` comment; LS-DYNA reads {law_note})",
                         exact.law_name()
@@ -1215,7 +1231,7 @@ fn part_def(cx: &mut Ctx, p: &PartInfo, name: &str) -> Result<PartDef, String> {
                     spec = card;
                 } else {
                     cx.warn.push(format!(
-                        "{}: `$palpa: card` does not describe {} {mid} (density, shear modulus or wave speed differ); the LS-DYNA card is used",
+                        "{}: `$palpa: card` does not describe {} {mid} (its constants are not those the LS-DYNA card holds); the LS-DYNA card is used",
                         m.at, m.keyword
                     ));
                 }
@@ -1237,6 +1253,41 @@ fn part_def(cx: &mut Ctx, p: &PartInfo, name: &str) -> Result<PartDef, String> {
         spec,
         formulation,
     })
+}
+
+/// Whether palpa's card (`exact`) is the one the LS-DYNA card (`deck`) was written from: the
+/// constants both hold agree to 1e-9 (the export writes them to 1e-13 or exactly).
+fn describes(exact: &Material, deck: &Material) -> bool {
+    let eq = |a: f64, b: f64| (a - b).abs() <= 1e-9 * a.abs().max(b.abs());
+    let all = |a: &[f64], b: &[f64]| a.len() == b.len() && a.iter().zip(b).all(|(x, y)| eq(*x, *y));
+    if !eq(exact.density(), deck.density()) {
+        return false;
+    }
+    match (exact, deck) {
+        (Material::Ogden(a), Material::Ogden(b)) => {
+            let ta: Vec<f64> = a.prony().iter().flat_map(|t| [t.modulus, t.tau]).collect();
+            let tb: Vec<f64> = b.prony().iter().flat_map(|t| [t.modulus, t.tau]).collect();
+            all(a.mu(), b.mu()) && all(a.alpha(), b.alpha()) && eq(a.bulk, b.bulk) && all(&ta, &tb)
+        }
+        // Written as a one-term Ogden law, alpha = 2, mu, with the same bulk modulus.
+        (Material::NeoHookean(a), Material::Ogden(b)) => {
+            all(b.mu(), &[a.mu])
+                && all(b.alpha(), &[2.0])
+                && eq(b.bulk, a.lambda + 2.0 * a.mu / 3.0)
+        }
+        (Material::LinearElastic(a), Material::LinearElastic(b)) => {
+            eq(a.lambda, b.lambda) && eq(a.mu, b.mu)
+        }
+        (Material::SimplifiedRubber(a), Material::SimplifiedRubber(b)) => {
+            eq(a.bulk, b.bulk)
+                && eq(a.damping, b.damping)
+                && (eq(a.shear, b.shear) || b.shear == 0.0)
+        }
+        (Material::PiecewiseLinearPlasticity(a), Material::PiecewiseLinearPlasticity(b)) => {
+            eq(a.bulk, b.bulk) && eq(a.shear, b.shear)
+        }
+        _ => false,
+    }
 }
 
 /// The scene card an LS-DYNA material stands for, and a one-line summary.
