@@ -255,7 +255,7 @@ mod tests {
 
     #[test]
     fn fixed_free_and_long_formats() {
-        let b = block(Format::Standard, "         1   1.0e-6      2.0d-3   0.3");
+        let b = block(Format::Standard, "         1    1.0e-6    2.0d-3       0.3");
         let f = fields(&b, Some(&b.cards[0]), L).unwrap();
         assert_eq!(f.int("MID", 0).unwrap(), 1);
         assert_eq!(f.real_req("RO").unwrap(), 1e-6);
