@@ -7,7 +7,7 @@
 //! numbers of `*NODE` and `*ELEMENT_*`, 16 for `*NODE` coordinates, 20 for `*DEFINE_CURVE`
 //! points); `*KEYWORD LONG=Y` (or a keyword written with a trailing `+`) makes every field 20
 //! columns wide, `*KEYWORD I10=Y` (or a trailing `%`) makes the 8-column fields 10 wide, and a
-//! trailing `-` returns one keyword to the standard format.
+//! trailing `-` returns one keyword to the standard format (on `*INCLUDE`, the included file).
 //!
 //! `*INCLUDE` reads another file in place (its name relative to the including file, then to the
 //! `*INCLUDE_PATH` directories); `*END` ends the file it is in. A comment line that starts with
@@ -241,7 +241,14 @@ fn read_file(
                                 .join(", ")
                         ));
                     };
-                    read_file(&found, Some(&name_loc), out, search, deck_format, depth + 1)?;
+                    read_file(
+                        &found,
+                        Some(&name_loc),
+                        out,
+                        search,
+                        fmt.unwrap_or(deck_format),
+                        depth + 1,
+                    )?;
                     continue;
                 }
                 _ => {}
