@@ -155,7 +155,7 @@ fn coarse_reduced_phantom_mesh() {
     let j = min_scaled_jacobian(&r);
     assert!(j > 0.0 && j <= 1.0, "{r}");
     assert!(r.contains("meshing + smoothing wall time"), "{r}");
-    let mesh = solver::output::vtu_read::read_vtu_mesh(&vtu).unwrap();
+    let mesh = solver::mesh_io::read_mesh(&vtu, 1.0).unwrap().mesh;
     assert_eq!(mesh.elements.len(), hexes);
     for f in ["roi.json", "roi.csv", "locations.json"] {
         assert!(d.join(f).is_file(), "{f} missing");
@@ -202,8 +202,8 @@ fn nifti_round_trip_gives_the_same_mesh() {
     let (n1, e1, p1) = counts(&r1, &parts);
     let (n2, e2, p2) = counts(&r2, &parts);
     assert_eq!((n1, e1, p1), (n2, e2, p2), "direct:\n{r1}\nimage:\n{r2}");
-    let a = solver::output::vtu_read::read_vtu_mesh(&direct).unwrap();
-    let b = solver::output::vtu_read::read_vtu_mesh(&again).unwrap();
+    let a = solver::mesh_io::read_mesh(&direct, 1.0).unwrap().mesh;
+    let b = solver::mesh_io::read_mesh(&again, 1.0).unwrap().mesh;
     assert_eq!(a.elements, b.elements);
     assert_eq!(a.element_part, b.element_part);
     let dmax = a

@@ -79,7 +79,7 @@ pub fn vtk_model(mesh: &Mesh, frame: &Frame, title: &str) -> Vtk {
         ));
     }
     Vtk {
-        version: Version::new((1, 0)),
+        version: Version::new_xml(1, 0),
         title: title.to_string(),
         byte_order: ByteOrder::LittleEndian,
         file_path: None,

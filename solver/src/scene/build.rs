@@ -149,6 +149,7 @@ fn read_mesh(
     scene: &Path,
     src: &str,
     prebuilt: Option<Phantom>,
+    notes: &mut Vec<String>,
 ) -> Result<(Mesh, Option<Phantom>), String> {
     if spec.phantom.is_some() && spec.generator.as_deref() != Some("phantom") {
         return Err(err(
@@ -219,7 +220,13 @@ fn read_mesh(
         )),
         (None, Some(f)) => {
             let p = scene.parent().unwrap_or(Path::new(".")).join(f);
-            crate::output::vtu_read::read_vtu_mesh(&p)
+            let scale = mesh_units(spec, &p)
+                .map_err(|e| err(scene, src, "mesh.units", Some("units"), e))?;
+            crate::mesh_io::read_mesh(&p, scale)
+                .map(|m| {
+                    notes.extend(m.notes);
+                    m.mesh
+                })
                 .map_err(|e| err(scene, src, "mesh.file", Some("file"), e))
         }
         _ => Err(err(
@@ -231,6 +238,32 @@ fn read_mesh(
         )),
     }?;
     Ok((mesh, None))
+}
+
+/// Metres per unit of a mesh file's coordinates: `[mesh] units`, required for formats that
+/// carry no unit (Gmsh, Abaqus); VTK files default to m, as palpa writes them.
+fn mesh_units(spec: &MeshSpec, file: &Path) -> Result<f64, String> {
+    match &spec.units {
+        Some(u) => {
+            let q = material::quantity::Quantity::parse(&format!("1 {u}"))?;
+            q.get(material::quantity::Dim::LENGTH)
+                .map_err(|_| format!("`{u}` is not a length unit (give e.g. \"mm\" or \"m\")"))
+        }
+        None => {
+            let ext = file
+                .extension()
+                .map(|e| e.to_string_lossy().to_ascii_lowercase())
+                .unwrap_or_default();
+            if ext == "msh" || ext == "inp" {
+                Err(format!(
+                    "{} states no unit: give the length unit of its coordinates, e.g. `units = \"mm\"` under [mesh]",
+                    file.display()
+                ))
+            } else {
+                Ok(1.0)
+            }
+        }
+    }
 }
 
 fn formulation(p: &PartSpec) -> Result<Formulation, String> {
@@ -322,7 +355,8 @@ pub fn resolve_scene(
             &format!("must lie in (0, 1], got {dt_factor}"),
         ));
     }
-    let (mut mesh, mut phantom) = read_mesh(&spec.mesh, path, src, prebuilt)?;
+    let mut notes = Vec::new();
+    let (mut mesh, mut phantom) = read_mesh(&spec.mesh, path, src, prebuilt, &mut notes)?;
     for (i, h) in spec.hands.iter_mut().enumerate() {
         place_hand(h, phantom.as_ref())
             .map_err(|m| e(&format!("hand[{i}]"), Some(&format!("\"{}\"", h.name)), &m))?;
@@ -713,7 +747,7 @@ pub fn resolve_scene(
         mesh,
         phantom,
         setup,
-        notes: Vec::new(),
+        notes,
     })
 }
 
