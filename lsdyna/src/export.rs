@@ -4,7 +4,7 @@
 //! The deck is what [`crate::scene`] reads back: the mesh as `*NODE` / `*ELEMENT_SOLID` (ids
 //! from 1 in palpa's order), each part with its `*SECTION_SOLID`, `*HOURGLASS` and `*MAT_...`,
 //! the boundary conditions on titled node sets (the scene's set names), the indenters as
-//! `*MAT_RIGID` parts meshed with hexahedra ([`crate::shapes`]) and moved by
+//! `*MAT_RIGID` parts meshed with hexahedra ([`contact::tessellate`]) and moved by
 //! `*BOUNDARY_PRESCRIBED_MOTION_RIGID`, the contact as one
 //! `*CONTACT_AUTOMATIC_SURFACE_TO_SURFACE` per indenter against a `*SET_SEGMENT` of exactly the
 //! faces palpa's contact uses, and the output requests.
@@ -32,8 +32,8 @@
 //! - the hourglass guard, dynamic relaxation, a `dt_min` time and palpa's contact numerics
 //!   (stiffness cap, samples, margins) are comments only.
 
-use crate::shapes::{self, HexMesh};
 use crate::units::Units;
+use contact::tessellate::{self as shapes, HexMesh};
 use contact::{Curve as MCurve, MotionSpec, PenaltyKind, ShapeSpec};
 use material::quantity::Dim;
 use material::{Material, MaterialSpec};

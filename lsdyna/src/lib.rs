@@ -23,7 +23,6 @@ pub mod export;
 pub mod keywords;
 pub mod lex;
 pub mod scene;
-mod shapes;
 pub mod units;
 
 pub use scene::{DeckError, ReadOptions, Report};

@@ -1,9 +1,8 @@
-//! Hexahedral meshes of palpa's analytic indenter shapes, for writing them as rigid parts.
-//!
-//! A rigid part needs only its surface, so each shape is meshed as a closed, outward-oriented
-//! quadrilateral surface extruded halfway towards the shape's core into one layer of
-//! hexahedra (a hollow solid): the outer faces lie on the exact surface, every hexahedron has
-//! a positive Jacobian, and the mesh stays small.
+//! Meshes of the analytic indenter shapes: their closed, outward-oriented quadrilateral
+//! surface ([`surface`], which palpa's frames draw the fingers with), and that surface
+//! extruded halfway towards the shape's core into one layer of hexahedra ([`mesh`], a hollow
+//! solid, which the LS-DYNA export writes as a rigid part): the outer faces lie on the exact
+//! surface, every hexahedron has a positive Jacobian, and the mesh stays small.
 //!
 //! - sphere: the cube-sphere (each face of a cube, `n x n` quadrilaterals, projected onto the
 //!   sphere with the map `x sqrt(1 - y^2/2 - z^2/2 + y^2 z^2/3)` and its permutations, which
@@ -17,7 +16,7 @@
 //! Nodes lie exactly on the surface (up to rounding); the chord error of `4n` segments around
 //! a circle of radius `r` is `r (1 - cos(pi / (4n)))` (0.12 % of `r` for `4n = 64`).
 
-use contact::ShapeSpec;
+use crate::ShapeSpec;
 use std::collections::HashMap;
 
 /// A hexahedral mesh (nodes in m, VTK_HEXAHEDRON order).
@@ -78,15 +77,21 @@ fn spherify(p: V) -> V {
     ]
 }
 
-/// The closed quad surface and, per vertex, the point of the core it is pulled towards.
-struct Surface {
-    verts: Vec<V>,
-    core: Vec<V>,
-    quads: Vec<[u32; 4]>,
+/// A closed quadrilateral surface (outward by the right-hand rule) and, per vertex, the point
+/// of the shape's core it is pulled towards to make the hollow mesh.
+#[derive(Clone, Debug, Default)]
+pub struct Surface {
+    /// Vertices (m).
+    pub verts: Vec<V>,
+    /// Per vertex, its core point (m).
+    pub core: Vec<V>,
+    /// Quadrilaterals (vertex indices).
+    pub quads: Vec<[u32; 4]>,
 }
 
 impl Surface {
-    fn into_hollow(self) -> HexMesh {
+    /// One layer of hexahedra from the surface halfway to the core.
+    pub fn into_hollow(self) -> HexMesh {
         let n = self.verts.len() as u32;
         let mut nodes = self.verts.clone();
         for (v, c) in self.verts.iter().zip(&self.core) {
@@ -170,12 +175,12 @@ fn cube_point(k: [usize; 3], n: usize) -> V {
 }
 
 /// A sphere.
-pub fn sphere(center: V, radius: f64, segments: usize) -> HexMesh {
+pub fn sphere(center: V, radius: f64, segments: usize) -> Surface {
     capsule(center, [0.0, 0.0, 1.0], radius, 0.0, segments)
 }
 
 /// A capsule: tip hemisphere centred at `a`, axis `axis`, straight length `length`.
-pub fn capsule(a: V, axis: V, radius: f64, length: f64, segments: usize) -> HexMesh {
+pub fn capsule(a: V, axis: V, radius: f64, length: f64, segments: usize) -> Surface {
     let n = (segments / 4).max(2) & !1; // even: the equator is a grid line
     let (u, v, w) = frame(axis);
     let (keys, cq) = cube_grid(n);
@@ -244,11 +249,11 @@ pub fn capsule(a: V, axis: V, radius: f64, length: f64, segments: usize) -> HexM
         *c = add(a, mul(h, w));
     }
     s.orient();
-    s.into_hollow()
+    s
 }
 
 /// A flat-ended cylinder: pressing face centred at `c`, extending `length` along `axis`.
-pub fn cylinder(c: V, axis: V, radius: f64, length: f64, segments: usize) -> HexMesh {
+pub fn cylinder(c: V, axis: V, radius: f64, length: f64, segments: usize) -> Surface {
     let n = (segments / 4).max(2);
     let (u, v, w) = frame(axis);
     let rings = ((length / (radius * std::f64::consts::PI * 2.0 / (4 * n) as f64)).ceil() as usize)
@@ -332,11 +337,11 @@ pub fn cylinder(c: V, axis: V, radius: f64, length: f64, segments: usize) -> Hex
         *cc = add(core_a, mul(t, seg));
     }
     s.orient();
-    s.into_hollow()
+    s
 }
 
-/// A box: one hexahedron.
-pub fn boxed(center: V, half: V, axes: Option<[[f64; 3]; 3]>) -> HexMesh {
+/// The corners of a box in VTK_HEXAHEDRON order.
+fn box_corners(center: V, half: V, axes: Option<[[f64; 3]; 3]>) -> Vec<V> {
     let a = axes.unwrap_or([[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]]);
     let e0 = unit(a[0]);
     let e1 = unit(sub(a[1], mul(dot(a[1], e0), e0)));
@@ -350,18 +355,30 @@ pub fn boxed(center: V, half: V, axes: Option<[[f64; 3]; 3]>) -> HexMesh {
             ),
         )
     };
-    let nodes = solver::mesh::CORNERS
-        .iter()
-        .map(|c| corner(c[0], c[1], c[2]))
-        .collect();
+    const SIGNS: [[f64; 3]; 8] = [
+        [-1.0, -1.0, -1.0],
+        [1.0, -1.0, -1.0],
+        [1.0, 1.0, -1.0],
+        [-1.0, 1.0, -1.0],
+        [-1.0, -1.0, 1.0],
+        [1.0, -1.0, 1.0],
+        [1.0, 1.0, 1.0],
+        [-1.0, 1.0, 1.0],
+    ];
+    SIGNS.iter().map(|c| corner(c[0], c[1], c[2])).collect()
+}
+
+/// A box: one hexahedron.
+pub fn boxed(center: V, half: V, axes: Option<[[f64; 3]; 3]>) -> HexMesh {
     HexMesh {
-        nodes,
+        nodes: box_corners(center, half, axes),
         elements: vec![[0, 1, 2, 3, 4, 5, 6, 7]],
     }
 }
 
-/// The mesh of a shape, or why it has none.
-pub fn mesh(shape: &ShapeSpec, segments: usize) -> Result<HexMesh, String> {
+/// The surface of a shape (outward quadrilaterals), or why it has none. `segments`: around a
+/// great circle of a sphere, capsule or cylinder.
+pub fn surface(shape: &ShapeSpec, segments: usize) -> Result<Surface, String> {
     Ok(match shape {
         ShapeSpec::Sphere { center, radius } => sphere(*center, *radius, segments),
         ShapeSpec::Capsule {
@@ -380,74 +397,43 @@ pub fn mesh(shape: &ShapeSpec, segments: usize) -> Result<HexMesh, String> {
             center,
             half_extents,
             axes,
-        } => boxed(*center, *half_extents, *axes),
-        ShapeSpec::Plane { .. } => {
-            return Err("an infinite plane has no mesh; give the indenter a box shape".into())
+        } => {
+            let verts = box_corners(*center, *half_extents, *axes);
+            Surface {
+                core: vec![*center; 8],
+                verts,
+                // The hexahedron's faces, outward.
+                quads: vec![
+                    [0, 3, 2, 1],
+                    [4, 5, 6, 7],
+                    [0, 1, 5, 4],
+                    [2, 3, 7, 6],
+                    [0, 4, 7, 3],
+                    [1, 2, 6, 5],
+                ],
+            }
         }
+        ShapeSpec::Plane { .. } => return Err("an infinite plane has no surface mesh".into()),
         ShapeSpec::Stl { .. } | ShapeSpec::Triangles { .. } => {
-            return Err("a triangle mesh is written as shells, not meshed".into())
+            return Err("a triangle mesh is its own surface".into())
         }
     })
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    fn check(m: &HexMesh, shape: &ShapeSpec) {
-        let s = contact::Shape::from_spec(shape).unwrap();
-        for (k, e) in m.elements.iter().enumerate() {
-            let x: [[f64; 3]; 8] = std::array::from_fn(|a| m.nodes[e[a] as usize]);
-            let (det, _) = solver::hex::corner_jacobians(&x);
-            assert!(det.iter().all(|&d| d > 0.0), "element {k}: {det:?}");
+/// The hollow hexahedral mesh of a shape (a box is one hexahedron), or why it has none.
+pub fn mesh(shape: &ShapeSpec, segments: usize) -> Result<HexMesh, String> {
+    match shape {
+        ShapeSpec::Box {
+            center,
+            half_extents,
+            axes,
+        } => Ok(boxed(*center, *half_extents, *axes)),
+        ShapeSpec::Plane { .. } => {
+            Err("an infinite plane has no mesh; give the indenter a box shape".into())
         }
-        // Outer nodes on the surface, inner ones inside; the boundary is closed.
-        let mut mesh = solver::mesh::Mesh {
-            nodes: m.nodes.clone(),
-            elements: m.elements.clone(),
-            ..Default::default()
-        };
-        mesh.element_part = vec![0; m.elements.len()];
-        let faces = mesh.boundary_faces();
-        let expected = if m.elements.len() == 1 {
-            6
-        } else {
-            2 * m.elements.len()
-        };
-        assert_eq!(faces.len(), expected);
-        for p in &m.nodes {
-            assert!(s.signed_distance(*p).0 < 1e-12, "{p:?}");
+        ShapeSpec::Stl { .. } | ShapeSpec::Triangles { .. } => {
+            Err("a triangle mesh is written as shells, not meshed".into())
         }
-    }
-
-    #[test]
-    fn shapes_mesh_with_positive_jacobians_and_nodes_on_the_surface() {
-        let sp = ShapeSpec::Sphere {
-            center: [0.0, 0.0, 0.005],
-            radius: 0.005,
-        };
-        let m = mesh(&sp, 32).unwrap();
-        check(&m, &sp);
-        assert_eq!(m.elements.len(), 6 * 8 * 8);
-        let cap = ShapeSpec::Capsule {
-            center: [0.01, 0.0, 0.0075],
-            axis: [0.1, 0.2, 1.0],
-            radius: 0.0075,
-            length: 0.045,
-        };
-        check(&mesh(&cap, 64).unwrap(), &cap);
-        let cyl = ShapeSpec::Cylinder {
-            center: [0.0, 0.0, 0.0],
-            axis: [0.0, 0.0, 1.0],
-            radius: 0.002,
-            length: 0.01,
-        };
-        check(&mesh(&cyl, 32).unwrap(), &cyl);
-        let bx = ShapeSpec::Box {
-            center: [0.0; 3],
-            half_extents: [0.01, 0.02, 0.03],
-            axes: None,
-        };
-        check(&mesh(&bx, 8).unwrap(), &bx);
+        other => surface(other, segments).map(Surface::into_hollow),
     }
 }
