@@ -2114,13 +2114,17 @@ fn indenter(
             (
                 if sign < 0.0 { dir.map(|x| -x) } else { dir },
                 motion,
-                format!(
-                    "{} along ({:.4}, {:.4}, {:.4})",
-                    if m.vad == 0 { "velocity" } else { "displacement" },
-                    dir[0] * sign,
-                    dir[1] * sign,
-                    dir[2] * sign
-                ),
+                {
+                    // Rounded first, so that a tiny negative component prints as 0.0000.
+                    let r = |x: f64| (x * sign * 1e4).round() / 1e4 + 0.0;
+                    format!(
+                        "{} along ({:.4}, {:.4}, {:.4})",
+                        if m.vad == 0 { "velocity" } else { "displacement" },
+                        r(dir[0]),
+                        r(dir[1]),
+                        r(dir[2])
+                    )
+                },
             )
         }
         many => {
