@@ -236,3 +236,42 @@ fn reduced_phantom_at_10mm() {
         d.join("phantom.vtu").to_str().unwrap(),
     ]);
 }
+
+/// `palpa mesh import`: a Gmsh file needs its unit; with it, the report lists the parts and
+/// sets, and the written .vtu reads back with the part names.
+#[test]
+fn mesh_import_reports_and_converts() {
+    let tmp = dir("import");
+    let out = tmp.path().join("block.vtu");
+    let r = palpa(&["mesh", "import", "tests/meshes/gmsh.msh"]);
+    let err = String::from_utf8_lossy(&r.stderr);
+    assert!(
+        !r.status.success() && err.contains("gmsh.msh") && err.contains("--units"),
+        "{err}"
+    );
+    let r = ok(&[
+        "mesh",
+        "import",
+        "tests/meshes/gmsh.msh",
+        "--units",
+        "mm",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(r.contains("36 nodes, 12 hexahedra, 2 part(s)"), "{r}");
+    assert!(r.contains("extent 0.030 x 0.020 x 0.020 mm"), "{r}");
+    assert!(
+        r.contains("part_id 0 left") && r.contains("part_id 1 right"),
+        "{r}"
+    );
+    assert!(r.contains("node set    xmin"), "{r}");
+    let m = solver::mesh_io::read_mesh(&out, 1.0).unwrap().mesh;
+    assert_eq!(m.part_names, ["left", "right"]);
+    assert!((m.bounds().1[0] - 3e-5).abs() < 1e-18);
+    let r = palpa(&["mesh", "import", "tests/meshes/mixed.vtu"]);
+    let err = String::from_utf8_lossy(&r.stderr);
+    assert!(
+        !r.status.success() && err.contains("11 hexahedra and 1 wedge"),
+        "{err}"
+    );
+}

@@ -39,9 +39,11 @@
 //! `<name>_travel`: the indenter's travel along its direction (m); `<name>_depth`: travel since
 //! first contact (m); `<name>_area`: current area of the penetrating sample points (m^2);
 //! `<name>_max_penetration` (m). The VTK frames get `contact_pressure` (Pa), per node the mean of
-//! the contact pressures of its surface faces.
+//! the contact pressures of its surface faces, and each frame the indenters' surfaces (see
+//! [`crate::output::vtk::write_surfaces`]).
 
 use crate::mesh::Mesh;
+use crate::output::vtk::RigidSurface;
 use crate::scene::contact_spec::{
     ContactScene, HandScene, IndenterScene, MotionScene, ShapeScene, DEFAULT_SOFT_SCALE,
 };
@@ -70,6 +72,8 @@ pub struct ContactForceStage {
     t_prev: Option<f64>,
     max_dt: f64,
     columns: Vec<String>,
+    /// Indenter surfaces at t = 0, in the order of the stage's indenters.
+    drawn: Vec<RigidSurface>,
 }
 
 impl ContactForceStage {
@@ -110,6 +114,7 @@ impl ContactForceStage {
             t_prev: None,
             max_dt,
             columns,
+            drawn: Vec::new(),
         }
     }
 
@@ -186,6 +191,18 @@ impl ForceStage for ContactForceStage {
 
     fn history_columns(&self) -> Vec<String> {
         self.columns.clone()
+    }
+
+    fn surfaces(&self) -> Vec<RigidSurface> {
+        self.drawn
+            .iter()
+            .zip(self.stage.indenters())
+            .filter(|(d, _)| !d.polygons.is_empty())
+            .map(|(d, s)| RigidSurface {
+                displacement: s.offset,
+                ..d.clone()
+            })
+            .collect()
     }
 
     fn history_values(&self, out: &mut Vec<f64>) {
@@ -721,15 +738,57 @@ pub fn build_stage(
     let faces = surface.faces.clone();
     let stage = ContactStage::new(&specs, surface, &mesh.nodes, &model.mass, params)
         .map_err(|e| format!("{}: {e}", path.display()))?;
+    let drawn = surfaces_of(&specs);
     contact.indenters = specs
         .into_iter()
         .zip(origins)
         .map(|(spec, origin)| IndenterDef { spec, origin })
         .collect();
-    Ok(ContactForceStage::new(
-        stage,
-        faces,
-        mesh.nodes.len(),
-        sim.settings.dt_factor,
-    ))
+    let mut st = ContactForceStage::new(stage, faces, mesh.nodes.len(), sim.settings.dt_factor);
+    st.drawn = drawn;
+    Ok(st)
+}
+
+/// Segments around a great circle of the indenter surfaces drawn in the frames.
+const DRAW_SEGMENTS: usize = 32;
+
+/// The surfaces of the indenters at t = 0, for the frames: analytic shapes tessellated
+/// ([`contact::tessellate::surface`]), triangle meshes as they are; an infinite plane is not
+/// drawn.
+fn surfaces_of(specs: &[IndenterSpec]) -> Vec<RigidSurface> {
+    specs
+        .iter()
+        .map(|spec| {
+            let mut s = RigidSurface {
+                name: spec.name.clone(),
+                vertices: Vec::new(),
+                polygons: Vec::new(),
+                displacement: [0.0; 3],
+            };
+            for part in &spec.parts {
+                let base = s.vertices.len() as u32;
+                match contact::tessellate::surface(part, DRAW_SEGMENTS) {
+                    Ok(q) => {
+                        s.vertices.extend(q.verts);
+                        s.polygons.extend(
+                            q.quads
+                                .iter()
+                                .map(|q| q.iter().map(|&i| base + i).collect()),
+                        );
+                    }
+                    Err(_) => {
+                        if let Ok(contact::Shape::Mesh(m)) = contact::Shape::from_spec(part) {
+                            s.vertices.extend_from_slice(m.vertices());
+                            s.polygons.extend(
+                                m.triangles()
+                                    .iter()
+                                    .map(|t| t.iter().map(|&i| base + i).collect()),
+                            );
+                        }
+                    }
+                }
+            }
+            s
+        })
+        .collect()
 }

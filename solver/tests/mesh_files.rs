@@ -283,3 +283,66 @@ fn every_file_runs_to_the_box_twin_and_the_closed_form() {
         assert!(d.abs() < 1e-9, "{f}: {r} against the twin's {twin}");
     }
 }
+
+/// palpa's own frames: zlib-compressed, the part names in the field data; read back, the mesh
+/// is the same bit for bit, names included. The indenter file holds the surfaces and names.
+#[test]
+fn palpa_frames_keep_part_names_and_draw_indenters() {
+    use solver::output::vtk::{write_surfaces, write_vtu, Frame, RigidSurface};
+    let mut mesh = solver::generate::box_mesh(
+        &solver::generate::BoxSpec {
+            size: [0.03, 0.02, 0.01],
+            divisions: [3, 2, 1],
+            grading: [1.3, 1.0, 1.0],
+            ..Default::default()
+        },
+        "fat",
+    )
+    .unwrap();
+    mesh.part_names = vec!["fat".into(), "liver tissue".into()];
+    mesh.element_part = (0..6).map(|e| (e % 2) as u32).collect();
+    let dir = tempfile::tempdir().unwrap();
+    let p = dir.path().join("frame.vtu");
+    let frame = Frame {
+        part: true,
+        ..Default::default()
+    };
+    write_vtu(&p, &mesh, &frame, "t").unwrap();
+    let text = std::fs::read(&p).unwrap();
+    assert!(
+        String::from_utf8_lossy(&text[..300]).contains("compressor=\"vtkZLibDataCompressor\""),
+        "frames are compressed"
+    );
+    let back = read_mesh(&p, 1.0).unwrap().mesh;
+    assert_eq!(back.nodes, mesh.nodes);
+    assert_eq!(back.elements, mesh.elements);
+    assert_eq!(back.element_part, mesh.element_part);
+    assert_eq!(back.part_names, mesh.part_names);
+
+    let sq = RigidSurface {
+        name: "finger".into(),
+        vertices: vec![[0.0; 3], [1.0, 0.0, 0.0], [1.0, 1.0, 0.0], [0.0, 1.0, 0.0]],
+        polygons: vec![vec![0, 1, 2, 3], vec![0, 2, 3]],
+        displacement: [0.0, 0.0, -1e-3],
+    };
+    let s = dir.path().join("indenters.vtu");
+    write_surfaces(
+        &s,
+        &[
+            sq.clone(),
+            RigidSurface {
+                name: "thumb".into(),
+                ..sq
+            },
+        ],
+        "t",
+    )
+    .unwrap();
+    let names = solver::mesh_io::xml::field_strings(&std::fs::read(&s).unwrap(), "indenter_names");
+    assert_eq!(names.unwrap(), ["finger", "thumb"]);
+    let e = read_mesh(&s, 1.0).err().unwrap();
+    assert!(
+        e.contains("no hexahedra") && e.contains("2 quadrilaterals, 2 triangles"),
+        "{e}"
+    );
+}
