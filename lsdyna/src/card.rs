@@ -96,6 +96,24 @@ pub fn fields(
             ));
         }
     }
+    if !block.params.is_empty() || values.iter().any(|v| v.contains('&')) {
+        for (k, v) in values.iter_mut().enumerate() {
+            match crate::params::substitute(v, &block.params) {
+                Ok(Some(x)) => *v = x,
+                Ok(None) => {}
+                Err(e) => {
+                    let cols = match cols[k] {
+                        Some((a, b)) => format!(" (columns {a}-{b})"),
+                        None => String::new(),
+                    };
+                    return Err(format!(
+                        "{}: *{}, field {}{cols}: {e}",
+                        card.at, block.name, layout[k].0
+                    ));
+                }
+            }
+        }
+    }
     Ok(Fields {
         at: card.at,
         keyword: block.name.clone(),
@@ -248,6 +266,7 @@ mod tests {
                 at,
             }],
             palpa: Vec::new(),
+            params: Default::default(),
         }
     }
 

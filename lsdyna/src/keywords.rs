@@ -1060,7 +1060,8 @@ fn unsupported_hint(name: &str) -> &'static str {
         ("CONTROL_DYNAMIC_RELAXATION", "palpa's dynamic relaxation is a scene option ([relaxation]), not LS-DYNA's"),
         ("RIGIDWALL", "model the wall as a rigid (*MAT_RIGID) part in *CONTACT"),
         ("INITIAL_STRESS", "palpa starts from the stress-free reference state"),
-        ("PARAMETER", "palpa does not expand *PARAMETER: replace each &NAME by its value"),
+        ("PARAMETER_EXPRESSION", "palpa expands *PARAMETER but does not evaluate expressions: give the values"),
+        ("PARAMETER_", "palpa reads plain *PARAMETER (and *PARAMETER_LOCAL)"),
         ("DEFINE_TABLE", "only *DEFINE_CURVE is read"),
         ("DEFINE_TRANSFORMATION", "transform the nodes before reading the deck"),
         ("INCLUDE_TRANSFORM", "transform the nodes before reading the deck"),
@@ -1119,6 +1120,8 @@ fn parse_block(d: &mut Deck, b: &Block) -> Result<(), String> {
         "TITLE" => {
             d.title = Some(c.title());
         }
+        // Read by the lexer (crate::params): its values replace `&NAME` in later cards.
+        "PARAMETER" | "PARAMETER_LOCAL" => {}
         "NODE" => {
             d.node_palpa.extend(b.palpa.iter().cloned());
             for card in c.rest() {

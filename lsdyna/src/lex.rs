@@ -77,6 +77,8 @@ pub struct Block {
     pub cards: Vec<Card>,
     /// `$palpa:` comments inside the keyword: (where, text after `$palpa:`).
     pub palpa: Vec<(Loc, String)>,
+    /// The `*PARAMETER` values defined before this keyword.
+    pub params: Arc<crate::params::Params>,
 }
 
 /// Every keyword of a deck and its included files, in reading order.
@@ -95,6 +97,7 @@ pub fn read(path: &Path) -> Result<Lexed, String> {
     let mut out = Lexed::default();
     let mut search: Vec<PathBuf> = Vec::new();
     read_file(path, None, &mut out, &mut search, Format::Standard, 0)?;
+    crate::params::expand(&mut out)?;
     Ok(out)
 }
 
@@ -260,6 +263,7 @@ fn read_file(
                 at: loc,
                 cards: Vec::new(),
                 palpa: Vec::new(),
+                params: Default::default(),
             });
             continue;
         }

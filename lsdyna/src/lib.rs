@@ -4,7 +4,7 @@
 //!
 //! Reading goes in three steps, each its own module:
 //! - [`lex`]: the keyword format (fixed columns, free format, long and i10 formats, `$`
-//!   comments, `*INCLUDE`);
+//!   comments, `*INCLUDE`), and [`params`]: `*PARAMETER` values for `&NAME` fields;
 //! - [`keywords`]: the keywords palpa knows, parsed into plain records in deck units, and the
 //!   verdict (warning or error) on every other keyword;
 //! - [`scene`]: the records turned into a palpa scene in SI, with the unit system the user
@@ -22,6 +22,7 @@ pub mod card;
 pub mod export;
 pub mod keywords;
 pub mod lex;
+pub mod params;
 pub mod scene;
 pub mod units;
 

@@ -175,8 +175,8 @@ fn what_would_change_the_physics_is_an_error_naming_file_line_and_field() {
         ),
         (
             "param",
-            "*PARAMETER\nRrho       1.0e-6\n",
-            &["param.k:", "*PARAMETER", "&NAME"],
+            "*PARAMETER_EXPRESSION\nR rho     1.0e-6*1.0\n",
+            &["param.k:", "*PARAMETER_EXPRESSION", "expressions"],
         ),
         (
             "mpc",
@@ -258,4 +258,47 @@ fn free_format_long_format_and_includes_read_the_same_block() {
         .0;
     assert_eq!(d.mesh.nodes, base.mesh.nodes);
     assert_eq!(d.mesh.elements, base.mesh.elements);
+}
+
+/// `*PARAMETER`: `&NAME` and `-&NAME` read as the values (the same scene as the literal deck);
+/// an undefined name and a second definition are errors naming the field and both lines.
+#[test]
+fn parameters_read_as_their_values() {
+    let dir = tempfile::tempdir().unwrap();
+    let base = read_deck(&write(dir.path(), "base.k", &prepost_deck("")), &kg_mm_ms())
+        .unwrap()
+        .0;
+    let with = prepost_deck("")
+        .replace(
+            "*CONTROL_TERMINATION",
+            "*PARAMETER\nR   YOUNG     1.0e-3R   TEND      -10.0\n*PARAMETER\nI NONE,0\n*CONTROL_TERMINATION",
+        )
+        .replace("      10.0         0", "    -&tend     &NONE")
+        .replace("    1.0e-6    1.0e-3", "    1.0e-6    &YOUNG");
+    let d = read_deck(&write(dir.path(), "par.k", &with), &kg_mm_ms())
+        .unwrap()
+        .0;
+    assert_eq!(d.end_time, base.end_time);
+    assert_eq!(d.mesh.nodes, base.mesh.nodes);
+    let show = |s: &solver::scene::def::SceneDef| format!("{:?}", s.setup.parts[0].spec);
+    assert_eq!(show(&d), show(&base));
+    let undefined = with.replace("    1.0e-6    &YOUNG", "    1.0e-6   &YOUNGS");
+    let e = fails(&write(dir.path(), "undef.k", &undefined), &kg_mm_ms())
+        .errors
+        .join("\n");
+    assert!(
+        e.contains("undef.k:")
+            && e.contains("field E (columns 21-30)")
+            && e.contains("`&YOUNGS` is not defined"),
+        "{e}"
+    );
+    let twice = with.replace("I NONE,0", "R YOUNG,2.0");
+    let e = fails(&write(dir.path(), "twice.k", &twice), &kg_mm_ms())
+        .errors
+        .join("\n");
+    assert!(
+        e.contains("twice.k:7: *PARAMETER: parameter `YOUNG` is defined again (first at ")
+            && e.contains("twice.k:5)"),
+        "{e}"
+    );
 }
