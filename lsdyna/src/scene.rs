@@ -2028,10 +2028,6 @@ fn indenter(
             p.mat.at, p.mat.keyword, p.card.material
         ));
     };
-    let rot_msg = format!(
-        "{}: {} {} (rigid part {} `{}`): palpa's rigid parts translate along one direction and do not rotate; set CMO = 1 and CON2 = 7",
-        p.mat.at, p.mat.keyword, p.card.material, p.card.id, p.card.title
-    );
     let (direction, motion, how) = match motions.map(|v| v.as_slice()).unwrap_or(&[]) {
         [] => {
             if held_t != [true; 3] || held_r != [true; 3] {
@@ -2043,25 +2039,45 @@ fn indenter(
             ([0.0, 0.0, -1.0], MotionSpec::Fixed, "fixed".to_string())
         }
         [m] => {
-            if held_r != [true; 3] {
-                return Err(rot_msg);
-            }
             let at = format!("{}: *BOUNDARY_PRESCRIBED_MOTION_RIGID", m.at);
+            // palpa's rigid parts move along the prescribed direction only. LS-DYNA leaves the
+            // degrees of freedom that *MAT_RIGID does not hold free: the two agree when the
+            // contact pushes the part neither sideways nor round, as in a normal indentation.
+            let free_t: Vec<&str> = match m.dof {
+                1..=3 => (0..3)
+                    .filter(|&k| k != (m.dof - 1) as usize && !held_t[k])
+                    .map(|k| ["x", "y", "z"][k])
+                    .collect(),
+                _ => Vec::new(),
+            };
+            if held_r != [true; 3] || !free_t.is_empty() {
+                let (code, along) = match m.dof {
+                    1 => ("5", "x"),
+                    2 => ("6", "y"),
+                    3 => ("4", "z"),
+                    _ => ("7", "its vector"),
+                };
+                let mut free = Vec::new();
+                if !free_t.is_empty() {
+                    free.push(format!("its translation along {}", free_t.join(" and ")));
+                }
+                if held_r != [true; 3] {
+                    free.push("its rotations".to_string());
+                }
+                cx.warn.push(format!(
+                    "{}: {} {} (rigid part {} `{}`): palpa moves the part along {along} only and holds {}, which LS-DYNA leaves free (CMO = {cmo}, CON1 = {con1}, CON2 = {con2}); set CMO = 1, CON1 = {code}, CON2 = 7 for the same model in both",
+                    p.mat.at,
+                    p.mat.keyword,
+                    p.card.material,
+                    p.card.id,
+                    p.card.title,
+                    free.join(" and "),
+                ));
+            }
             let dir: [f64; 3] = match m.dof {
                 1..=3 => {
-                    let a = (m.dof - 1) as usize;
-                    if (0..3).any(|k| k != a && !held_t[k]) {
-                        return Err(format!(
-                            "{at}: palpa moves the rigid part `{}` along {} only; hold its other translations with CON1 in *MAT_RIGID ({}; CON1 = {} for motion along {}), or prescribe DOF -4 along a vector",
-                            p.card.title,
-                            ["x", "y", "z"][a],
-                            p.mat.at,
-                            [5, 6, 4][a],
-                            ["x", "y", "z"][a]
-                        ));
-                    }
                     let mut v = [0.0; 3];
-                    v[a] = 1.0;
+                    v[(m.dof - 1) as usize] = 1.0;
                     v
                 }
                 -4 => vector(d, m.vid, &at)?,

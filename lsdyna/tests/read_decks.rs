@@ -302,3 +302,52 @@ fn parameters_read_as_their_values() {
         "{e}"
     );
 }
+
+/// A rigid punch meshed with one solid, moved along z with CMO = 0 (LS-DYNA leaves its other
+/// degrees of freedom free): palpa reads it as an indenter, holds them, and says so.
+#[test]
+fn a_rigid_solid_with_free_rotations_reads_with_a_warning() {
+    let dir = tempfile::tempdir().unwrap();
+    let punch = "*PART
+punch
+         2         1         2
+*MAT_RIGID
+         2    7.8e-6     210.0       0.3
+*NODE
+     101             5.0             2.0            10.5
+     102            15.0             2.0            10.5
+     103            15.0             8.0            10.5
+     104             5.0             8.0            10.5
+     105             5.0             2.0            15.0
+     106            15.0             2.0            15.0
+     107            15.0             8.0            15.0
+     108             5.0             8.0            15.0
+*ELEMENT_SOLID
+     101       2     101     102     103     104     105     106     107     108
+*DEFINE_CURVE
+         7
+                 0.0                 0.0
+                10.0                -1.0
+*BOUNDARY_PRESCRIBED_MOTION_RIGID
+         2         3         2         7
+*CONTACT_AUTOMATIC_SURFACE_TO_SURFACE
+         1         2         3         3
+";
+    let p = write(dir.path(), "punch.k", &prepost_deck(punch));
+    let (def, report) = read_deck(&p, &kg_mm_ms()).unwrap();
+    assert_eq!(
+        def.mesh.part_names,
+        ["block"],
+        "the rigid part is no mesh part"
+    );
+    let ind = &def.setup.contact.as_ref().unwrap().indenters;
+    assert_eq!(ind.len(), 1);
+    assert_eq!(ind[0].spec.direction, [0.0, 0.0, -1.0]);
+    let w = report.warnings.join("\n");
+    assert!(
+        w.contains("punch.k:")
+            && w.contains("its translation along x and y and its rotations")
+            && w.contains("CMO = 1, CON1 = 4, CON2 = 7"),
+        "{w}"
+    );
+}
