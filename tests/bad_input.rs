@@ -181,7 +181,7 @@ fn inverted_element_is_named() {
     let (ok, err) = check(&p);
     assert!(!ok);
     assert!(
-        err.contains("element 5") && err.contains("non-positive Jacobian"),
+        err.contains("inv.vtu") && err.contains("cell 5") && err.contains("non-positive Jacobian"),
         "{err}"
     );
 }

@@ -155,7 +155,7 @@ fn coarse_reduced_phantom_mesh() {
     let j = min_scaled_jacobian(&r);
     assert!(j > 0.0 && j <= 1.0, "{r}");
     assert!(r.contains("meshing + smoothing wall time"), "{r}");
-    let mesh = solver::output::vtu_read::read_vtu_mesh(&vtu).unwrap();
+    let mesh = solver::mesh_io::read_mesh(&vtu, 1.0).unwrap().mesh;
     assert_eq!(mesh.elements.len(), hexes);
     for f in ["roi.json", "roi.csv", "locations.json"] {
         assert!(d.join(f).is_file(), "{f} missing");
@@ -202,8 +202,8 @@ fn nifti_round_trip_gives_the_same_mesh() {
     let (n1, e1, p1) = counts(&r1, &parts);
     let (n2, e2, p2) = counts(&r2, &parts);
     assert_eq!((n1, e1, p1), (n2, e2, p2), "direct:\n{r1}\nimage:\n{r2}");
-    let a = solver::output::vtu_read::read_vtu_mesh(&direct).unwrap();
-    let b = solver::output::vtu_read::read_vtu_mesh(&again).unwrap();
+    let a = solver::mesh_io::read_mesh(&direct, 1.0).unwrap().mesh;
+    let b = solver::mesh_io::read_mesh(&again, 1.0).unwrap().mesh;
     assert_eq!(a.elements, b.elements);
     assert_eq!(a.element_part, b.element_part);
     let dmax = a
@@ -235,4 +235,43 @@ fn reduced_phantom_at_10mm() {
         "--out",
         d.join("phantom.vtu").to_str().unwrap(),
     ]);
+}
+
+/// `palpa mesh import`: a Gmsh file needs its unit; with it, the report lists the parts and
+/// sets, and the written .vtu reads back with the part names.
+#[test]
+fn mesh_import_reports_and_converts() {
+    let tmp = dir("import");
+    let out = tmp.path().join("block.vtu");
+    let r = palpa(&["mesh", "import", "tests/meshes/gmsh.msh"]);
+    let err = String::from_utf8_lossy(&r.stderr);
+    assert!(
+        !r.status.success() && err.contains("gmsh.msh") && err.contains("--units"),
+        "{err}"
+    );
+    let r = ok(&[
+        "mesh",
+        "import",
+        "tests/meshes/gmsh.msh",
+        "--units",
+        "mm",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert!(r.contains("36 nodes, 12 hexahedra, 2 part(s)"), "{r}");
+    assert!(r.contains("extent 0.030 x 0.020 x 0.020 mm"), "{r}");
+    assert!(
+        r.contains("part_id 0 left") && r.contains("part_id 1 right"),
+        "{r}"
+    );
+    assert!(r.contains("node set    xmin"), "{r}");
+    let m = solver::mesh_io::read_mesh(&out, 1.0).unwrap().mesh;
+    assert_eq!(m.part_names, ["left", "right"]);
+    assert!((m.bounds().1[0] - 3e-5).abs() < 1e-18);
+    let r = palpa(&["mesh", "import", "tests/meshes/mixed.vtu"]);
+    let err = String::from_utf8_lossy(&r.stderr);
+    assert!(
+        !r.status.success() && err.contains("11 hexahedra and 1 wedge"),
+        "{err}"
+    );
 }

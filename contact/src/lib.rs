@@ -7,7 +7,8 @@
 //! penetration. All quantities are SI (m, s, kg, N, Pa, J).
 //!
 //! - [`shape`]: analytic rigid shapes (sphere, capsule, cylinder, box, plane) with exact signed
-//!   distances; [`trimesh`]: STL triangle meshes with a BVH and pseudo-normal signs.
+//!   distances; [`trimesh`]: STL triangle meshes with a BVH and pseudo-normal signs;
+//!   [`tessellate`]: quadrilateral surfaces and hollow hexahedral meshes of the analytic shapes.
 //! - [`indenter`]: indenters (unions of parts moving along a direction) and the two-finger
 //!   [`HandSpec`] preset.
 //! - [`motion`]: prescribed displacement/velocity curves and force control.
@@ -50,6 +51,7 @@ pub mod indenter;
 pub mod motion;
 pub mod shape;
 pub mod stage;
+pub mod tessellate;
 pub mod trimesh;
 mod vec3;
 

@@ -95,6 +95,14 @@ pub enum ShapeSpec {
         #[serde(default)]
         translate: [f64; 3],
     },
+    /// Closed triangle mesh given in memory, e.g. the surface of a meshed rigid part of an
+    /// LS-DYNA deck: vertices (m) and triangles, counter-clockwise seen from outside.
+    Triangles {
+        /// Vertices (m).
+        vertices: Vec<[f64; 3]>,
+        /// Vertex indices of each triangle.
+        triangles: Vec<[u32; 3]>,
+    },
 }
 
 fn one() -> f64 {
@@ -288,6 +296,13 @@ impl Shape {
                 let mesh = TriMesh::from_stl_file(path, *scale, *translate)?;
                 Shape::Mesh(std::sync::Arc::new(mesh))
             }
+            ShapeSpec::Triangles {
+                vertices,
+                triangles,
+            } => Shape::Mesh(std::sync::Arc::new(TriMesh::new(
+                vertices.clone(),
+                triangles.clone(),
+            )?)),
         })
     }
 

@@ -174,6 +174,16 @@ impl TriMesh {
         self.nodes[0].bb
     }
 
+    /// Vertices (m).
+    pub fn vertices(&self) -> &[[f64; 3]] {
+        &self.vertices
+    }
+
+    /// Triangles (vertex indices, counter-clockwise seen from outside).
+    pub fn triangles(&self) -> &[[u32; 3]] {
+        &self.triangles
+    }
+
     /// Mean edge length (m).
     pub fn mean_edge_length(&self) -> f64 {
         self.mean_edge

@@ -39,11 +39,15 @@
 //! `<name>_travel`: the indenter's travel along its direction (m); `<name>_depth`: travel since
 //! first contact (m); `<name>_area`: current area of the penetrating sample points (m^2);
 //! `<name>_max_penetration` (m). The VTK frames get `contact_pressure` (Pa), per node the mean of
-//! the contact pressures of its surface faces.
+//! the contact pressures of its surface faces, and each frame the indenters' surfaces (see
+//! [`crate::output::vtk::write_surfaces`]).
 
+use crate::mesh::Mesh;
+use crate::output::vtk::RigidSurface;
 use crate::scene::contact_spec::{
     ContactScene, HandScene, IndenterScene, MotionScene, ShapeScene, DEFAULT_SOFT_SCALE,
 };
+use crate::scene::def::{ContactDef, HandDef, IndenterDef, SurfaceSel};
 use crate::scene::spec::CurveSpec;
 use crate::simulation::{ForceStage, Simulation};
 use contact::{
@@ -68,6 +72,8 @@ pub struct ContactForceStage {
     t_prev: Option<f64>,
     max_dt: f64,
     columns: Vec<String>,
+    /// Indenter surfaces at t = 0, in the order of the stage's indenters.
+    drawn: Vec<RigidSurface>,
 }
 
 impl ContactForceStage {
@@ -108,6 +114,7 @@ impl ContactForceStage {
             t_prev: None,
             max_dt,
             columns,
+            drawn: Vec::new(),
         }
     }
 
@@ -184,6 +191,18 @@ impl ForceStage for ContactForceStage {
 
     fn history_columns(&self) -> Vec<String> {
         self.columns.clone()
+    }
+
+    fn surfaces(&self) -> Vec<RigidSurface> {
+        self.drawn
+            .iter()
+            .zip(self.stage.indenters())
+            .filter(|(d, _)| !d.polygons.is_empty())
+            .map(|(d, s)| RigidSurface {
+                displacement: s.offset,
+                ..d.clone()
+            })
+            .collect()
     }
 
     fn history_values(&self, out: &mut Vec<f64>) {
@@ -418,7 +437,8 @@ pub fn contact_params(c: Option<&ContactScene>, design_dt: f64) -> Result<Contac
     Ok(p)
 }
 
-/// The contact crate's hand for a scene's `[[hand]]`, with the fingertips `gap` (m) back.
+/// The contact crate's hand for a scene's `[[hand]]` (placed: `point` and `direction` given),
+/// with the fingertips `gap` (m) back.
 fn hand_spec(h: &HandScene, gap: f64) -> Result<HandSpec, String> {
     let (Some(point), Some(direction)) = (&h.point, h.direction) else {
         return Err(
@@ -440,64 +460,77 @@ fn hand_spec(h: &HandScene, gap: f64) -> Result<HandSpec, String> {
     })
 }
 
-/// Build the contact stage for a scene: indenters and hands in SI, the contact surface from the
-/// mesh boundary, and the parameters. `path` is the scene file (for messages and relative STL
-/// paths), `src` its text (for line numbers).
-pub fn build_stage(
-    sim: &Simulation,
+/// Resolve a scene's `[[indenter]]`, `[[hand]]` and `[contact]` tables against its mesh: the
+/// indenters in SI, the hands (placed, not yet backed off the skin), the surface selection and
+/// the contact parameters. `path` is the scene file (for messages and relative STL paths), `src`
+/// its text (for line numbers).
+pub fn resolve_contact(
+    mesh: &Mesh,
     indenters: &[IndenterScene],
     hands: &[HandScene],
     contact: Option<&ContactScene>,
     path: &Path,
     src: &str,
-    notes: &mut Vec<String>,
-) -> Result<ContactForceStage, String> {
-    let at = |needle: &str, key: &str, msg: &dyn std::fmt::Display| {
-        let line = src
-            .lines()
+) -> Result<ContactDef, String> {
+    let line_of = |needle: &str| {
+        src.lines()
             .position(|l| l.contains(needle))
-            .map(|i| format!(":{}", i + 1))
-            .unwrap_or_default();
-        format!("{}{line}: `{key}`: {msg}", path.display())
+            .map(|i| format!("{}:{}", path.display(), i + 1))
+            .unwrap_or_else(|| path.display().to_string())
+    };
+    let at = |needle: &str, key: &str, msg: &dyn std::fmt::Display| {
+        format!("{}: `{key}`: {msg}", line_of(needle))
     };
     let base = path.parent().unwrap_or(Path::new("."));
-    let mut specs = Vec::new();
+    let mut defs = Vec::new();
     for (i, ind) in indenters.iter().enumerate() {
         let key = format!("indenter[{i}]");
         let name_at = format!("\"{}\"", ind.name);
         if ind.part.is_empty() {
             return Err(at(&name_at, &key, &"an indenter needs at least one `part`"));
         }
-        specs.push(IndenterSpec {
-            name: ind.name.clone(),
-            parts: ind.part.iter().map(|s| shape(s, base)).collect(),
-            direction: ind.direction,
-            motion: motion(&ind.motion).map_err(|m| at(&name_at, &key, &m))?,
-            friction: ind.friction.map(|f| f.0),
+        defs.push(IndenterDef {
+            spec: IndenterSpec {
+                name: ind.name.clone(),
+                parts: ind.part.iter().map(|s| shape(s, base)).collect(),
+                direction: ind.direction,
+                motion: motion(&ind.motion).map_err(|m| at(&name_at, &key, &m))?,
+                friction: ind.friction.map(|f| f.0),
+            },
+            origin: line_of(&name_at),
         });
     }
+    let mut hand_defs = Vec::new();
     for (i, h) in hands.iter().enumerate() {
         let key = format!("hand[{i}]");
         let name_at = format!("\"{}\"", h.name);
         let hs = hand_spec(h, h.gap.map_or(0.0, |g| g.0)).map_err(|m| at(&name_at, &key, &m))?;
-        specs.push(hs.to_indenter_spec().map_err(|e| at(&name_at, &key, &e))?);
+        hs.to_indenter_spec().map_err(|e| at(&name_at, &key, &e))?;
+        hand_defs.push(HandDef {
+            hand: hs,
+            gap_given: h.gap.is_some(),
+            placed: h.location.is_some() || h.at.is_some(),
+            origin: line_of(&name_at),
+        });
     }
     let mut names = HashSet::new();
-    for s in &specs {
-        if !names.insert(s.name.as_str()) {
+    for n in defs
+        .iter()
+        .map(|d| d.spec.name.as_str())
+        .chain(hand_defs.iter().map(|h| h.hand.name.as_str()))
+    {
+        if !names.insert(n) {
             return Err(at(
-                &format!("\"{}\"", s.name),
+                &format!("\"{n}\""),
                 "indenter.name",
-                &format!("two indenters or hands are named `{}`", s.name),
+                &format!("two indenters or hands are named `{n}`"),
             ));
         }
     }
 
     // Surface.
-    let model = &sim.model;
-    let mesh = &model.mesh;
     let c = contact;
-    let in_set: Option<Vec<bool>> = match c.and_then(|c| c.surface.as_ref()) {
+    let nodes: Option<Vec<bool>> = match c.and_then(|c| c.surface.as_ref()) {
         None => None,
         Some(name) => {
             let nodes = mesh.node_sets.get(name).ok_or_else(|| {
@@ -515,7 +548,7 @@ pub fn build_stage(
             Some(m)
         }
     };
-    let part_ok: Option<Vec<bool>> = match c.and_then(|c| c.parts.as_ref()) {
+    let parts: Option<Vec<bool>> = match c.and_then(|c| c.parts.as_ref()) {
         None => None,
         Some(ps) => {
             let mut ok = vec![false; mesh.part_names.len()];
@@ -532,6 +565,51 @@ pub fn build_stage(
             Some(ok)
         }
     };
+    let d = ContactScene::default();
+    let mut params =
+        contact_params(Some(c.unwrap_or(&d)), 0.0).map_err(|m| at("[contact]", "contact", &m))?;
+    params.design_dt = c.and_then(|c| c.design_dt).map(|t| t.0);
+    Ok(ContactDef {
+        indenters: defs,
+        hands: hand_defs,
+        surface: SurfaceSel {
+            nodes,
+            parts,
+            faces: None,
+        },
+        params,
+        origin: format!("{}: `contact`", path.display()),
+        empty_hint: "check `surface` and `parts`".into(),
+    })
+}
+
+/// Build the contact stage of a resolved scene: the surface from the mesh boundary (restricted
+/// by the selection), the design step (the run's initial step unless given), and the indenters,
+/// with each hand that starts inside the surface backed off until it just touches it. On return
+/// `contact.indenters` holds every indenter as it runs (hands included) and `contact.hands` is
+/// empty. `path` is the scene file (for messages).
+pub fn build_stage(
+    sim: &Simulation,
+    contact: &mut ContactDef,
+    path: &Path,
+    notes: &mut Vec<String>,
+) -> Result<ContactForceStage, String> {
+    let mut specs: Vec<IndenterSpec> = contact.indenters.iter().map(|d| d.spec.clone()).collect();
+    let mut origins: Vec<String> = contact.indenters.iter().map(|d| d.origin.clone()).collect();
+    for h in &contact.hands {
+        specs.push(
+            h.hand
+                .to_indenter_spec()
+                .map_err(|e| format!("{}: `hand`: {e}", h.origin))?,
+        );
+        origins.push(h.origin.clone());
+    }
+    let hands = std::mem::take(&mut contact.hands);
+
+    // Surface.
+    let model = &sim.model;
+    let mesh = &model.mesh;
+    let sel = &contact.surface;
     let mut vol = vec![0.0; mesh.elements.len()];
     for g in &model.groups {
         for (&e, &v) in g.elements.iter().zip(&g.vol0) {
@@ -549,13 +627,20 @@ pub fn build_stage(
     let mut surface = ContactSurface::default();
     for f in mesh.boundary_faces() {
         let part = mesh.element_part[f.element as usize] as usize;
-        if let Some(ok) = &part_ok {
+        if let Some(ok) = &sel.parts {
             if !ok[part] {
                 continue;
             }
         }
-        if let Some(m) = &in_set {
+        if let Some(m) = &sel.nodes {
             if !f.nodes.iter().all(|&n| m[n as usize]) {
+                continue;
+            }
+        }
+        if let Some(faces) = &sel.faces {
+            let mut key = f.nodes;
+            key.sort_unstable();
+            if !faces.contains(&key) {
                 continue;
             }
         }
@@ -565,8 +650,8 @@ pub fn build_stage(
     }
     if surface.faces.is_empty() {
         return Err(format!(
-            "{}: `contact`: the contact surface has no face (check `surface` and `parts`)",
-            path.display()
+            "{}: the contact surface has no face ({})",
+            contact.origin, contact.empty_hint
         ));
     }
 
@@ -576,7 +661,10 @@ pub fn build_stage(
     // beyond first contact is the requested one. Any other indenter that starts inside the
     // surface by more than 5 % of its feature size is an error that names it.
     let design_dt = (sim.settings.dt_factor * model.scaled_dt).min(sim.settings.dt_max);
-    let params = contact_params(c, design_dt).map_err(|m| at("[contact]", "contact", &m))?;
+    let mut params = contact.params.clone();
+    if params.design_dt.is_none() {
+        params.design_dt = Some(design_dt);
+    }
     // Largest penetration of each indenter at t = 0 over the face samples, as the stage sees it.
     let zeros = vec![[0.0; 3]; mesh.nodes.len()];
     let measure = |specs: &[IndenterSpec]| -> Result<Vec<f64>, String> {
@@ -592,34 +680,32 @@ pub fn build_stage(
         st.apply(0.0, design_dt, &mesh.nodes, &zeros, &mut f);
         Ok(st.indenters().iter().map(|s| s.max_penetration).collect())
     };
-    let n_ind = indenters.len();
+    let n_ind = contact.indenters.len();
     let mut gaps = vec![0.0; hands.len()];
     for _ in 0..20 {
         let pens = measure(&specs)?;
         let mut moved = false;
         for (k, h) in hands.iter().enumerate() {
-            if h.gap.is_none() && pens[n_ind + k] > 1e-9 {
+            if !h.gap_given && pens[n_ind + k] > 1e-9 {
                 gaps[k] += pens[n_ind + k] + 1e-7;
-                specs[n_ind + k] = hand_spec(h, gaps[k])
-                    .and_then(|hs| hs.to_indenter_spec().map_err(|e| e.to_string()))
-                    .map_err(|m| at(&format!("\"{}\"", h.name), "hand", &m))?;
+                let mut hs = h.hand.clone();
+                hs.gap = gaps[k];
+                specs[n_ind + k] = hs
+                    .to_indenter_spec()
+                    .map_err(|e| format!("{}: `hand`: {e}", h.origin))?;
                 moved = true;
             }
         }
         if !moved {
-            for (spec, pen) in specs.iter().zip(&pens) {
+            for ((spec, pen), origin) in specs.iter().zip(&pens).zip(&origins) {
                 let size = contact::Indenter::from_spec(spec)
                     .map(|i| i.feature_size())
                     .unwrap_or(f64::INFINITY);
                 if *pen > 0.05 * size {
-                    return Err(at(
-                        &format!("\"{}\"", spec.name),
-                        "indenter",
-                        &format!(
-                            "`{}` starts {:.3} mm inside the contact surface; move it out (or give a hand no `gap`, and palpa backs it off)",
-                            spec.name,
-                            pen * 1e3
-                        ),
+                    return Err(format!(
+                        "{origin}: `indenter`: `{}` starts {:.3} mm inside the contact surface; move it out (or give a hand no `gap`, and palpa backs it off)",
+                        spec.name,
+                        pen * 1e3
                     ));
                 }
             }
@@ -631,8 +717,7 @@ pub fn build_stage(
         if gap <= 0.0 {
             continue;
         }
-        let placed = h.location.is_some() || h.at.is_some();
-        if placed {
+        if h.placed {
             if let MotionSpec::Displacement { curve } = &mut specs[n_ind + k].motion {
                 if let Curve::SmoothStep { amplitude, .. } | Curve::Ramp { amplitude, .. } = curve {
                     *amplitude += gap;
@@ -641,9 +726,9 @@ pub fn build_stage(
         }
         notes.push(format!(
             "hand `{}`: the fingertips started {:.3} mm inside the contact surface; backed off by that much{}",
-            h.name,
+            h.hand.name,
             gap * 1e3,
-            if placed {
+            if h.placed {
                 " and the travel extended to match"
             } else {
                 " (set `gap` to choose)"
@@ -653,10 +738,57 @@ pub fn build_stage(
     let faces = surface.faces.clone();
     let stage = ContactStage::new(&specs, surface, &mesh.nodes, &model.mass, params)
         .map_err(|e| format!("{}: {e}", path.display()))?;
-    Ok(ContactForceStage::new(
-        stage,
-        faces,
-        mesh.nodes.len(),
-        sim.settings.dt_factor,
-    ))
+    let drawn = surfaces_of(&specs);
+    contact.indenters = specs
+        .into_iter()
+        .zip(origins)
+        .map(|(spec, origin)| IndenterDef { spec, origin })
+        .collect();
+    let mut st = ContactForceStage::new(stage, faces, mesh.nodes.len(), sim.settings.dt_factor);
+    st.drawn = drawn;
+    Ok(st)
+}
+
+/// Segments around a great circle of the indenter surfaces drawn in the frames.
+const DRAW_SEGMENTS: usize = 32;
+
+/// The surfaces of the indenters at t = 0, for the frames: analytic shapes tessellated
+/// ([`contact::tessellate::surface`]), triangle meshes as they are; an infinite plane is not
+/// drawn.
+fn surfaces_of(specs: &[IndenterSpec]) -> Vec<RigidSurface> {
+    specs
+        .iter()
+        .map(|spec| {
+            let mut s = RigidSurface {
+                name: spec.name.clone(),
+                vertices: Vec::new(),
+                polygons: Vec::new(),
+                displacement: [0.0; 3],
+            };
+            for part in &spec.parts {
+                let base = s.vertices.len() as u32;
+                match contact::tessellate::surface(part, DRAW_SEGMENTS) {
+                    Ok(q) => {
+                        s.vertices.extend(q.verts);
+                        s.polygons.extend(
+                            q.quads
+                                .iter()
+                                .map(|q| q.iter().map(|&i| base + i).collect()),
+                        );
+                    }
+                    Err(_) => {
+                        if let Ok(contact::Shape::Mesh(m)) = contact::Shape::from_spec(part) {
+                            s.vertices.extend_from_slice(m.vertices());
+                            s.polygons.extend(
+                                m.triangles()
+                                    .iter()
+                                    .map(|t| t.iter().map(|&i| base + i).collect()),
+                            );
+                        }
+                    }
+                }
+            }
+            s
+        })
+        .collect()
 }

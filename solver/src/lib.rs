@@ -11,6 +11,7 @@ pub mod forces;
 pub mod generate;
 pub mod hex;
 pub mod mesh;
+pub mod mesh_io;
 pub mod model;
 pub mod output;
 pub mod palpation;

@@ -203,11 +203,13 @@ fn write_frame(scene: &Scene, series: &mut Series) -> Result<(), String> {
             ));
         }
     }
+    let mut surfaces = Vec::new();
     for st in &sim.stages {
         frame.point_scalars.extend(st.point_fields());
+        surfaces.extend(st.surfaces());
     }
     series
-        .write(sim.time, &sim.model.mesh, &frame, &scene.title)
+        .write(sim.time, &sim.model.mesh, &frame, &surfaces, &scene.title)
         .map(|_| ())
 }
 

@@ -147,6 +147,10 @@ pub trait ForceStage: Send {
     fn point_fields(&self) -> Vec<(String, Vec<f64>)> {
         Vec::new()
     }
+    /// Rigid surfaces to draw in the VTK frames (the indenters), at the current time.
+    fn surfaces(&self) -> Vec<crate::output::vtk::RigidSurface> {
+        Vec::new()
+    }
 }
 
 /// Default time-step safety factor: dt = factor * min_e kappa_p L_e / c_e with L_e = V / A_max

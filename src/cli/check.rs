@@ -1,16 +1,35 @@
-//! `palpa check SCENE`: validate without running.
+//! `palpa check SCENE`: validate without running. A keyword deck is also listed: its files,
+//! units, keywords, how each part and indenter was mapped, and every warning; a deck palpa
+//! cannot run gets every error listed, each with its file, line and field.
 
+use super::input::{check_failed_deck, load, print_report, DeckArgs};
 use solver::hex::corner_jacobians;
-use solver::scene::load_scene;
 use std::path::Path;
 
-/// Validate a scene and report what a run would do.
-pub fn check(path: &Path) -> Result<(), String> {
-    let scene = load_scene(path)?;
+/// Validate a scene or deck and report what a run would do.
+pub fn check(path: &Path, deck: &DeckArgs) -> Result<(), String> {
+    let loaded = match load(path, deck) {
+        Ok(l) => l,
+        Err(e) => {
+            if lsdyna::is_deck(path) {
+                if let Some(summary) = check_failed_deck(path, deck) {
+                    return Err(summary);
+                }
+            }
+            return Err(e);
+        }
+    };
+    let scene = loaded.scene;
     let sim = &scene.sim;
     let m = &sim.model;
     let mesh = &m.mesh;
     println!("scene {} is valid: `{}`", path.display(), scene.title);
+    if let Some(r) = &loaded.report {
+        print_report(r, true);
+    }
+    for n in &scene.notes {
+        println!("  note: {n}");
+    }
     println!(
         "  mesh: {} nodes, {} elements, {} parts",
         mesh.nodes.len(),

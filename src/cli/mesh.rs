@@ -44,6 +44,25 @@ pub enum MeshCommand {
     /// `.nii`/`.nii.gz` a copy of the input volume (a format conversion); a directory gets
     /// `mesh.vtu`. See scenes/labels-example.toml for a label map.
     Image(ImageArgs),
+    /// Read a hexahedral mesh another tool wrote (VTK `.vtu`/`.vtk` as VTK, ParaView or meshio
+    /// write them, Gmsh `.msh` 4.1, Abaqus `.inp`), check it as a scene's `[mesh] file` would
+    /// be checked, report its parts, sets and quality, and optionally write it as palpa's
+    /// `.vtu` (cell array `part_id`, part names in the field data `part_names`).
+    Import(ImportArgs),
+}
+
+/// `palpa mesh import` options.
+#[derive(Args)]
+pub struct ImportArgs {
+    /// The mesh file.
+    file: PathBuf,
+    /// The length unit of the file's coordinates (`mm`, `m`, ...); required for Gmsh and
+    /// Abaqus files, which carry none; VTK files default to m.
+    #[arg(long, value_name = "UNIT")]
+    units: Option<String>,
+    /// Write the mesh, in m, to this `.vtu`.
+    #[arg(long, value_name = "FILE.vtu")]
+    out: Option<PathBuf>,
 }
 
 /// Options shared by both mesh commands.
@@ -336,7 +355,70 @@ pub fn mesh(cmd: MeshCommand) -> Result<(), String> {
     match cmd {
         MeshCommand::Phantom(a) => mesh_phantom(a),
         MeshCommand::Image(a) => mesh_image(a),
+        MeshCommand::Import(a) => mesh_import(a),
     }
+}
+
+fn mesh_import(a: ImportArgs) -> Result<(), String> {
+    let ext = a
+        .file
+        .extension()
+        .map(|e| e.to_string_lossy().to_ascii_lowercase())
+        .unwrap_or_default();
+    let scale = match &a.units {
+        Some(u) => Quantity::parse(&format!("1 {u}"))
+            .and_then(|q| q.get(Dim::LENGTH))
+            .map_err(|e| format!("--units {u}: {e}"))?,
+        None if ext == "msh" || ext == "inp" => {
+            return Err(format!(
+                "{}: a {} file states no unit; give the length unit of its coordinates, e.g. --units mm",
+                a.file.display(),
+                if ext == "msh" { "Gmsh" } else { "Abaqus" }
+            ))
+        }
+        None => 1.0,
+    };
+    let imported = solver::mesh_io::read_mesh(&a.file, scale)?;
+    let mesh = &imported.mesh;
+    let q = MeshQuality::measure(mesh);
+    let (lo, hi) = mesh.bounds();
+    println!(
+        "{}: {} nodes, {} hexahedra, {} part(s); extent {:.3} x {:.3} x {:.3} mm from ({:.3}, {:.3}, {:.3}) mm",
+        a.file.display(),
+        q.n_nodes,
+        q.n_elements,
+        mesh.part_names.len(),
+        (hi[0] - lo[0]) * 1e3,
+        (hi[1] - lo[1]) * 1e3,
+        (hi[2] - lo[2]) * 1e3,
+        lo[0] * 1e3,
+        lo[1] * 1e3,
+        lo[2] * 1e3
+    );
+    for (i, (name, c)) in q.part_counts.iter().enumerate() {
+        println!("  part_id {i} {name:<16} {c:>9} hexahedra");
+    }
+    for (name, s) in &mesh.node_sets {
+        println!("  node set    {name:<16} {:>9} nodes", s.len());
+    }
+    for (name, s) in &mesh.element_sets {
+        println!("  element set {name:<16} {:>9} hexahedra", s.len());
+    }
+    println!(
+        "scaled Jacobian: min {:.3}, mean {:.3}; shortest edge {:.3} mm, smallest V/A_max {:.3} mm",
+        q.min_scaled_jacobian,
+        q.mean_scaled_jacobian,
+        q.min_edge * 1e3,
+        q.min_char_length * 1e3
+    );
+    for n in &imported.notes {
+        println!("note: {n}");
+    }
+    if let Some(out) = &a.out {
+        write_mesh(mesh, out, &format!("palpa import of {}", a.file.display()))?;
+        print_written(&[out.clone()]);
+    }
+    Ok(())
 }
 
 fn mesh_phantom(a: PhantomArgs) -> Result<(), String> {

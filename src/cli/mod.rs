@@ -5,6 +5,8 @@ mod calibrate;
 mod campaign;
 mod check;
 mod evaluate;
+mod export;
+mod input;
 mod material;
 mod mesh;
 mod palpate;
@@ -36,9 +38,10 @@ enum Command {
     /// Run a palpation campaign (the paper's protocol by default, or CAMPAIGN.toml) and write
     /// the surrogate's training dataset (dataset.npz + manifest.json); `merge` joins shards.
     Campaign(campaign::CampaignArgs),
-    /// Run a scene and write VTK frames, history.csv and summary.json into --out.
+    /// Run a scene (TOML) or an LS-DYNA keyword deck (.k) and write VTK frames, history.csv and
+    /// summary.json into --out.
     Run {
-        /// The scene file (TOML).
+        /// The scene file (TOML) or keyword deck (.k, .key, .dyn).
         scene: PathBuf,
         /// Output directory.
         #[arg(long, default_value = "results")]
@@ -49,12 +52,20 @@ enum Command {
         /// No progress bar.
         #[arg(long)]
         quiet: bool,
+        #[command(flatten)]
+        deck: input::DeckArgs,
     },
-    /// Validate a scene and report mesh, quality, stable step, mass scaling, memory and stages.
+    /// Validate a scene or keyword deck and report mesh, quality, stable step, mass scaling,
+    /// memory and stages (for a deck also its units, keywords, mapping and every warning).
     Check {
-        /// The scene file (TOML).
+        /// The scene file (TOML) or keyword deck (.k, .key, .dyn).
         scene: PathBuf,
+        #[command(flatten)]
+        deck: input::DeckArgs,
     },
+    /// Write a scene as an LS-DYNA keyword deck (`--lsdyna`) that LS-DYNA or the OpenRadioss
+    /// starter reads and `palpa run` runs to the same numbers.
+    Export(export::ExportArgs),
     /// Material-point driver: drive one law through the path of FILE.toml (uniaxial stress or
     /// strain, simple shear, equibiaxial; ramps, holds, cycles) and write the CSV table
     /// (time, stretch, nominal and Cauchy stress, wave speed, dissipation, history).
@@ -155,11 +166,13 @@ pub fn dispatch(cli: Cli) -> Result<(), String> {
             out,
             threads,
             quiet,
+            deck,
         } => {
             set_threads(threads)?;
-            run::run(&scene, &out, quiet)
+            run::run(&scene, &out, quiet, &deck)
         }
-        Command::Check { scene } => check::check(&scene),
+        Command::Check { scene, deck } => check::check(&scene, &deck),
+        Command::Export(a) => export::export(&a),
         Command::Study {
             quick,
             out,

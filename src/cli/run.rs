@@ -1,8 +1,9 @@
 //! `palpa run SCENE --out DIR`.
 
+use super::input::{load, print_report, DeckArgs};
 use super::progress::{stop_flag, time_bar};
 use solver::run::{run_scene, RunSummary};
-use solver::scene::{load_scene, Scene};
+use solver::scene::Scene;
 use std::path::Path;
 use std::time::Instant;
 
@@ -57,10 +58,15 @@ pub fn print_summary(s: &RunSummary) {
     }
 }
 
-/// Run a scene file.
-pub fn run(scene_path: &Path, out: &Path, quiet: bool) -> Result<(), String> {
+/// Run a scene file or an LS-DYNA deck.
+pub fn run(scene_path: &Path, out: &Path, quiet: bool, deck: &DeckArgs) -> Result<(), String> {
     let t0 = Instant::now();
-    let mut scene = load_scene(scene_path)?;
+    let loaded = load(scene_path, deck)?;
+    if let Some(r) = &loaded.report {
+        println!("deck {}: units {}", scene_path.display(), r.units);
+        print_report(r, false);
+    }
+    let mut scene = loaded.scene;
     if !quiet {
         println!(
             "scene {}: {} elements, {} nodes, built in {:.2} s",

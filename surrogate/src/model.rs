@@ -12,6 +12,12 @@
 //!   f64, normalised units. Version-1 files name `coef` `alpha` and have no basis.
 //! - Both: `roi_centroids` `[R, 3]` f64 [m], for rendering maps from the model alone.
 //!
+//! The safetensors header's `__metadata__` says what the file is without the JSON beside it
+//! (all values strings, lists as JSON): `format` (`palpa-surrogate`), `version`, `kind` (`mlp`
+//! or `gp`), `target` (`principal` or `tensor`), `input_columns` (`["x","y","force"]`),
+//! `input_units` (`["m","m","N"]`), `output` (what the served values are) and `output_unit`
+//! (`Pa`). `python/palpa_surrogate.py` reads both files with numpy alone.
+//!
 //! M is the number of raw outputs: R for the principal-stress target, 6R for the tensor target
 //! (`target`, recorded as the training report's `target`); [`Predictor`] always serves the R
 //! maximum principal stresses.
@@ -25,7 +31,7 @@ use crate::normalise::Scaling;
 use crate::report::TrainReport;
 use crate::target::TargetMap;
 use crate::tensor_file::{
-    read_tensors, take_f32, take_f64, write_tensors, Tensor, TensorData, TensorSet,
+    read_metadata, read_tensors, take_f32, take_f64, write_tensors, Tensor, TensorData, TensorSet,
 };
 use ndarray::{Array2, ArrayView2};
 use serde::{Deserialize, Serialize};
@@ -294,7 +300,23 @@ impl TrainedModel {
             report: report.clone(),
             domain: domain.cloned(),
         };
-        write_tensors(&st, &set)?;
+        let metadata = [
+            ("format", MODEL_FORMAT.to_string()),
+            ("version", MODEL_VERSION.to_string()),
+            ("kind", self.kind().to_string()),
+            ("target", report.target.to_string()),
+            ("input_columns", r#"["x","y","force"]"#.to_string()),
+            ("input_units", r#"["m","m","N"]"#.to_string()),
+            (
+                "output",
+                "maximum principal Cauchy stress of each ROI element".to_string(),
+            ),
+            ("output_unit", "Pa".to_string()),
+        ]
+        .into_iter()
+        .map(|(k, v)| (k.to_string(), v))
+        .collect();
+        write_tensors(&st, &set, &metadata)?;
         let text =
             serde_json::to_string_pretty(&meta).map_err(|e| Error::format(&js, e.to_string()))?;
         write_atomic(&js, |mut f| {
@@ -364,6 +386,25 @@ impl Predictor {
                     target
                 ),
             ));
+        }
+        // The tensors' own header must agree with the JSON beside them (files written before
+        // the header carried metadata have none).
+        let header = read_metadata(&st)?;
+        for (key, want) in [
+            ("kind", meta.kind.to_string()),
+            ("target", target.to_string()),
+        ] {
+            if let Some(got) = header.get(key) {
+                if *got != want {
+                    return Err(Error::format(
+                        &st,
+                        format!(
+                            "__metadata__ {key} is {got:?} but {} says {want:?}",
+                            js.display()
+                        ),
+                    ));
+                }
+            }
         }
         let mut set = read_tensors(&st)?;
         let c = take_f64(&mut set, &st, "roi_centroids", &[r, 3])?;

@@ -1,4 +1,5 @@
-//! Named f32/f64 tensors to and from a `.safetensors` file (little-endian, as the format says).
+//! Named f32/f64 tensors to and from a `.safetensors` file (little-endian, as the format says),
+//! with the format's `__metadata__` (string to string) in the header.
 
 use crate::dataset::write_atomic;
 use crate::error::{Error, Result};
@@ -28,8 +29,12 @@ pub struct Tensor {
 /// Tensors by name.
 pub type TensorSet = BTreeMap<String, Tensor>;
 
-/// Writes `tensors` to `path` atomically.
-pub fn write_tensors(path: &Path, tensors: &TensorSet) -> Result<()> {
+/// Writes `tensors` and the header's `__metadata__` to `path` atomically.
+pub fn write_tensors(
+    path: &Path,
+    tensors: &TensorSet,
+    metadata: &BTreeMap<String, String>,
+) -> Result<()> {
     let bytes: Vec<(String, Dtype, Vec<usize>, Vec<u8>)> = tensors
         .iter()
         .map(|(name, t)| {
@@ -52,11 +57,26 @@ pub fn write_tensors(path: &Path, tensors: &TensorSet) -> Result<()> {
                 .map_err(|e| Error::format(path, format!("tensor {n}: {e}")))
         })
         .collect::<Result<Vec<_>>>()?;
-    let buf = safetensors::serialize(views, None)
+    let meta: std::collections::HashMap<String, String> = metadata
+        .iter()
+        .map(|(k, v)| (k.clone(), v.clone()))
+        .collect();
+    let buf = safetensors::serialize(views, (!meta.is_empty()).then_some(meta))
         .map_err(|e| Error::format(path, format!("serialising: {e}")))?;
     write_atomic(path, |mut f| {
         f.write_all(&buf).map_err(|e| Error::io(path, e))
     })
+}
+
+/// The header's `__metadata__` of `path` (empty when it has none).
+pub fn read_metadata(path: &Path) -> Result<BTreeMap<String, String>> {
+    let buf = std::fs::read(path).map_err(|e| Error::io(path, e))?;
+    let (_, m) = SafeTensors::read_metadata(&buf)
+        .map_err(|e| Error::format(path, format!("not a safetensors file: {e}")))?;
+    Ok(m.metadata()
+        .clone()
+        .map(|h| h.into_iter().collect())
+        .unwrap_or_default())
 }
 
 /// Reads every tensor of `path` (f32 and f64 only).

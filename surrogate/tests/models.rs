@@ -220,7 +220,7 @@ fn tensor_gp_save_load_round_trip_predicts_identically() {
 
 #[test]
 fn version_1_gp_files_load_and_a_bad_output_basis_is_an_error() {
-    use surrogate::tensor_file::{read_tensors, write_tensors};
+    use surrogate::tensor_file::{read_metadata, read_tensors, write_tensors};
     let dir = tempfile::tempdir().unwrap();
     let d = make_synthetic_dataset(R);
     let opts = TrainOptions {
@@ -260,7 +260,8 @@ fn version_1_gp_files_load_and_a_bad_output_basis_is_an_error() {
     let mut set = read_tensors(&path).unwrap();
     let coef = set.remove("coef").unwrap();
     set.insert("alpha".into(), coef);
-    write_tensors(&path, &set).unwrap();
+    // version-1 files carried no header metadata
+    write_tensors(&path, &set, &Default::default()).unwrap();
     let json = path.with_extension("json");
     let text = std::fs::read_to_string(&json).unwrap();
     let mut meta: serde_json::Value = serde_json::from_str(&text).unwrap();
@@ -279,6 +280,24 @@ fn version_1_gp_files_load_and_a_bad_output_basis_is_an_error() {
     for (a, b) in got.iter().zip(&want) {
         assert!((a - b).abs() <= 1e-2 * scale, "{a} against {b}");
     }
+    // the header says what the file is: kind, target, version, inputs and units
+    let header = read_metadata(&path).unwrap();
+    assert_eq!(header["kind"], "gp");
+    assert_eq!(header["target"], "principal");
+    assert_eq!(header["version"], "2");
+    assert_eq!(header["input_columns"], r#"["x","y","force"]"#);
+    assert_eq!(header["input_units"], r#"["m","m","N"]"#);
+    assert_eq!(header["output_unit"], "Pa");
+    // a header that contradicts the JSON is an error naming the file
+    let set = read_tensors(&path).unwrap();
+    let mut wrong = header.clone();
+    wrong.insert("target".into(), "tensor".into());
+    write_tensors(&path, &set, &wrong).unwrap();
+    let err = Predictor::load(&path).unwrap_err().to_string();
+    assert!(
+        err.contains("m.safetensors") && err.contains("target"),
+        "{err}"
+    );
     // an empty basis would silently serve the mean field: it is an error naming the file
     let mut set = read_tensors(&path).unwrap();
     let m = set["basis"].shape[1];
@@ -297,7 +316,7 @@ fn version_1_gp_files_load_and_a_bad_output_basis_is_an_error() {
             data: surrogate::tensor_file::TensorData::F64(Vec::new()),
         },
     );
-    write_tensors(&path, &set).unwrap();
+    write_tensors(&path, &set, &header).unwrap();
     let err = Predictor::load(&path).unwrap_err().to_string();
     assert!(
         err.contains("m.safetensors") && err.contains("basis"),

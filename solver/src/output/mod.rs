@@ -1,5 +1,5 @@
 //! Output: ParaView-ready VTK XML unstructured grids with a `.pvd` time series, `history.csv`,
-//! and `.vtu` mesh reading. Every file is written atomically (temporary file in the same
+//! and the mesh written as a `.vtu`. Every file is written atomically (temporary file in the same
 //! directory, then rename), so an interrupted run leaves only complete files.
 
 pub mod atomic;
@@ -7,4 +7,3 @@ pub mod filter;
 pub mod history;
 pub mod stress;
 pub mod vtk;
-pub mod vtu_read;

@@ -1,9 +1,21 @@
-//! VTK XML unstructured-grid frames (`.vtu`, written with vtkio) and the `.pvd` collection
-//! that ParaView opens as a time series.
+//! VTK XML unstructured-grid frames (`.vtu`, written with vtkio, zlib-compressed) and the
+//! `.pvd` collection that ParaView opens as a time series.
 //!
 //! Point data: `displacement` (m), `velocity` (m/s). Cell data: `part_id`, `cauchy_stress`
 //! (Pa, full 3x3 tensor, which ParaView shows with its components), `von_mises` (Pa),
 //! `max_principal_stress` (Pa), and the laws' history variables, each only when requested.
+//! Field data: `part_names` (string `i` names `part_id` `i`), which palpa reads back.
+//!
+//! The indenters of a frame go to a second file of the same time step ([`write_surfaces`]):
+//! their surfaces as quadrilaterals and triangles at the start position, with the point data
+//! `displacement` (the indenter's travel, m), cell data `indenter_id` and field data
+//! `indenter_names`, so that ParaView's Warp By Vector moves tissue and fingers alike. The
+//! `.pvd` lists both files of a time step (`part="0"` the tissue, `part="1"` the indenters),
+//! which ParaView shows as two blocks of one dataset.
+//!
+//! vtkio writes no `<FieldData>`; [`with_field_strings`] adds it to the XML vtkio writes, as an
+//! ASCII string array (the bytes of each string in decimal, each string ended by a 0, as VTK
+//! writes ASCII string arrays).
 
 use super::atomic::write_atomic;
 use crate::mesh::Mesh;
@@ -12,6 +24,11 @@ use vtkio::model::{
     Attribute, Attributes, ByteOrder, CellType, Cells, DataArray, DataSet, IOBuffer,
     UnstructuredGridPiece, Version, VertexNumbers, Vtk,
 };
+use vtkio::xml::Compressor;
+
+/// zlib level of the frames: 1 (fastest) writes a frame of the 23k-hexahedron palpation model
+/// about as small as the default 6 does, in a fraction of the time.
+pub const ZLIB_LEVEL: u32 = 1;
 
 /// One frame's fields.
 #[derive(Default)]
@@ -79,7 +96,7 @@ pub fn vtk_model(mesh: &Mesh, frame: &Frame, title: &str) -> Vtk {
         ));
     }
     Vtk {
-        version: Version::new((1, 0)),
+        version: Version::new_xml(1, 0),
         title: title.to_string(),
         byte_order: ByteOrder::LittleEndian,
         file_path: None,
@@ -97,24 +114,142 @@ pub fn vtk_model(mesh: &Mesh, frame: &Frame, title: &str) -> Vtk {
     }
 }
 
-/// Write one `.vtu` file atomically.
-pub fn write_vtu(path: &Path, mesh: &Mesh, frame: &Frame, title: &str) -> Result<(), String> {
+/// Encode a model as zlib-compressed VTK XML.
+fn encode(vtk: Vtk, path: &Path) -> Result<Vec<u8>, String> {
     let mut buf = Vec::new();
-    vtk_model(mesh, frame, title)
-        .write_xml(&mut buf)
+    vtk.try_into_xml_format(Compressor::ZLib, ZLIB_LEVEL)
+        .and_then(|x| x.write(&mut buf))
         .map_err(|e| format!("{}: cannot encode VTK: {e}", path.display()))?;
-    write_atomic(path, &buf)
+    Ok(buf)
+}
+
+/// Add `<FieldData>` with one string array to the XML of an unstructured grid, right after
+/// its `<UnstructuredGrid>` tag.
+pub fn with_field_strings(xml: Vec<u8>, name: &str, strings: &[String]) -> Vec<u8> {
+    let tag = b"<UnstructuredGrid";
+    let Some(at) = xml.windows(tag.len()).position(|w| w == tag) else {
+        return xml;
+    };
+    let Some(end) = xml[at..]
+        .iter()
+        .position(|&b| b == b'>')
+        .map(|e| at + e + 1)
+    else {
+        return xml;
+    };
+    let bytes: Vec<String> = strings
+        .iter()
+        .flat_map(|s| {
+            s.bytes()
+                .filter(|&b| b != 0)
+                .map(|b| b.to_string())
+                .chain(std::iter::once("0".to_string()))
+        })
+        .collect();
+    let name: String = name
+        .chars()
+        .filter(|c| c.is_ascii_alphanumeric() || *c == '_')
+        .collect();
+    let field = format!(
+        "\n    <FieldData>\n      <Array type=\"String\" Name=\"{name}\" NumberOfTuples=\"{}\" format=\"ascii\">\n        {}\n      </Array>\n    </FieldData>",
+        strings.len(),
+        bytes.join(" ")
+    );
+    let mut out = Vec::with_capacity(xml.len() + field.len());
+    out.extend_from_slice(&xml[..end]);
+    out.extend_from_slice(field.as_bytes());
+    out.extend_from_slice(&xml[end..]);
+    out
+}
+
+/// Write one `.vtu` file atomically (zlib-compressed, with the part names).
+pub fn write_vtu(path: &Path, mesh: &Mesh, frame: &Frame, title: &str) -> Result<(), String> {
+    let buf = encode(vtk_model(mesh, frame, title), path)?;
+    write_atomic(
+        path,
+        &with_field_strings(buf, "part_names", &mesh.part_names),
+    )
+}
+
+/// A rigid surface of one frame: polygons (quadrilaterals and triangles) at the start position
+/// and the displacement that takes them to the frame's position.
+#[derive(Clone, Debug)]
+pub struct RigidSurface {
+    /// Indenter name.
+    pub name: String,
+    /// Vertices at t = 0 (m).
+    pub vertices: Vec<[f64; 3]>,
+    /// Polygons: 3 or 4 vertex indices each.
+    pub polygons: Vec<Vec<u32>>,
+    /// Displacement of every vertex (m).
+    pub displacement: [f64; 3],
+}
+
+/// Write the indenters of a frame as one `.vtu` of surface cells.
+pub fn write_surfaces(path: &Path, surfaces: &[RigidSurface], title: &str) -> Result<(), String> {
+    let mut points = Vec::new();
+    let mut disp = Vec::new();
+    let mut connectivity = Vec::new();
+    let mut offsets = Vec::new();
+    let mut types = Vec::new();
+    let mut ids = Vec::new();
+    for (k, s) in surfaces.iter().enumerate() {
+        let base = (points.len() / 3) as u64;
+        for v in &s.vertices {
+            points.extend_from_slice(v);
+            disp.extend_from_slice(&s.displacement);
+        }
+        for p in &s.polygons {
+            connectivity.extend(p.iter().map(|&i| base + i as u64));
+            offsets.push(connectivity.len() as u64);
+            types.push(if p.len() == 3 {
+                CellType::Triangle
+            } else {
+                CellType::Quad
+            });
+            ids.push(k as i32);
+        }
+    }
+    let mut attrs = Attributes::new();
+    attrs.point.push(Attribute::DataArray(
+        DataArray::vectors("displacement").with_data(disp),
+    ));
+    attrs.cell.push(Attribute::DataArray(
+        DataArray::scalars("indenter_id", 1).with_data(ids),
+    ));
+    let vtk = Vtk {
+        version: Version::new_xml(1, 0),
+        title: title.to_string(),
+        byte_order: ByteOrder::LittleEndian,
+        file_path: None,
+        data: DataSet::inline(UnstructuredGridPiece {
+            points: IOBuffer::F64(points),
+            cells: Cells {
+                cell_verts: VertexNumbers::XML {
+                    connectivity,
+                    offsets,
+                },
+                types,
+            },
+            data: attrs,
+        }),
+    };
+    let names: Vec<String> = surfaces.iter().map(|s| s.name.clone()).collect();
+    let buf = encode(vtk, path)?;
+    write_atomic(path, &with_field_strings(buf, "indenter_names", &names))
 }
 
 /// A `.pvd` time series.
 pub struct Series {
     dir: PathBuf,
     stem: String,
-    frames: Vec<(f64, String)>,
+    /// Per frame: its time and files (the tissue, then the indenters if any).
+    frames: Vec<(f64, Vec<String>)>,
 }
 
 impl Series {
-    /// A series of files `DIR/STEM_NNNN.vtu` listed in `DIR/STEM.pvd`.
+    /// A series of files `DIR/STEM_NNNN.vtu` (and `DIR/indenters_NNNN.vtu`) listed in
+    /// `DIR/STEM.pvd`.
     pub fn new(dir: &Path, stem: &str) -> Series {
         Series {
             dir: dir.to_path_buf(),
@@ -122,18 +257,26 @@ impl Series {
             frames: Vec::new(),
         }
     }
-    /// Write a frame and update the collection.
+    /// Write a frame (and its indenters, if any) and update the collection.
     pub fn write(
         &mut self,
         time: f64,
         mesh: &Mesh,
         frame: &Frame,
+        surfaces: &[RigidSurface],
         title: &str,
     ) -> Result<PathBuf, String> {
-        let name = format!("{}_{:04}.vtu", self.stem, self.frames.len());
+        let k = self.frames.len();
+        let name = format!("{}_{k:04}.vtu", self.stem);
         let path = self.dir.join(&name);
         write_vtu(&path, mesh, frame, title)?;
-        self.frames.push((time, name));
+        let mut files = vec![name];
+        if !surfaces.is_empty() {
+            let s = format!("indenters_{k:04}.vtu");
+            write_surfaces(&self.dir.join(&s), surfaces, title)?;
+            files.push(s);
+        }
+        self.frames.push((time, files));
         self.flush()?;
         Ok(path)
     }
@@ -149,10 +292,12 @@ impl Series {
         let mut s = String::from(
             "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\" byte_order=\"LittleEndian\">\n  <Collection>\n",
         );
-        for (t, f) in &self.frames {
-            s.push_str(&format!(
-                "    <DataSet timestep=\"{t:.9e}\" group=\"\" part=\"0\" file=\"{f}\"/>\n"
-            ));
+        for (t, files) in &self.frames {
+            for (part, f) in files.iter().enumerate() {
+                s.push_str(&format!(
+                    "    <DataSet timestep=\"{t:.9e}\" group=\"\" part=\"{part}\" file=\"{f}\"/>\n"
+                ));
+            }
         }
         s.push_str("  </Collection>\n</VTKFile>\n");
         write_atomic(&self.dir.join(format!("{}.pvd", self.stem)), s.as_bytes())

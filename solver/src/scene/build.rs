@@ -1,15 +1,16 @@
 //! Build a [`Scene`] (model, simulation, output plan) from a [`SceneSpec`].
 
 use super::contact_spec::HandScene;
+use super::def::{DtMin, HourglassGuard, PartDef, SceneDef, Setup};
 use super::spec::*;
 use crate::bc::{Constraint, Kinematic, NodalLoad};
 use crate::curve::Curve;
 use crate::element::{BulkViscosity, Formulation, Hourglass, HourglassForm, HourglassModulus};
 use crate::generate::{box_mesh, BoxSpec};
 use crate::mesh::Mesh;
-use crate::model::{MassScaling, Model, Part};
+use crate::model::MassScaling;
 use crate::phantom::Phantom;
-use crate::simulation::{DynamicRelaxation, HourglassLimit, LoopSettings, Simulation};
+use crate::simulation::{DynamicRelaxation, Simulation};
 use material::quantity::Length;
 use material::Material;
 use std::path::{Path, PathBuf};
@@ -61,6 +62,9 @@ pub struct Scene {
     pub phantom: Option<Phantom>,
     /// Things the builder adjusted that the user should know (printed before the run).
     pub notes: Vec<String>,
+    /// What runs on the mesh, as resolved (indenters as they run: hands turned into their
+    /// capsules and placed), for `palpa export`.
+    pub setup: super::def::Setup,
 }
 
 /// A scene error with its location.
@@ -145,6 +149,7 @@ fn read_mesh(
     scene: &Path,
     src: &str,
     prebuilt: Option<Phantom>,
+    notes: &mut Vec<String>,
 ) -> Result<(Mesh, Option<Phantom>), String> {
     if spec.phantom.is_some() && spec.generator.as_deref() != Some("phantom") {
         return Err(err(
@@ -215,7 +220,13 @@ fn read_mesh(
         )),
         (None, Some(f)) => {
             let p = scene.parent().unwrap_or(Path::new(".")).join(f);
-            crate::output::vtu_read::read_vtu_mesh(&p)
+            let scale = mesh_units(spec, &p)
+                .map_err(|e| err(scene, src, "mesh.units", Some("units"), e))?;
+            crate::mesh_io::read_mesh(&p, scale)
+                .map(|m| {
+                    notes.extend(m.notes);
+                    m.mesh
+                })
                 .map_err(|e| err(scene, src, "mesh.file", Some("file"), e))
         }
         _ => Err(err(
@@ -227,6 +238,32 @@ fn read_mesh(
         )),
     }?;
     Ok((mesh, None))
+}
+
+/// Metres per unit of a mesh file's coordinates: `[mesh] units`, required for formats that
+/// carry no unit (Gmsh, Abaqus); VTK files default to m, as palpa writes them.
+fn mesh_units(spec: &MeshSpec, file: &Path) -> Result<f64, String> {
+    match &spec.units {
+        Some(u) => {
+            let q = material::quantity::Quantity::parse(&format!("1 {u}"))?;
+            q.get(material::quantity::Dim::LENGTH)
+                .map_err(|_| format!("`{u}` is not a length unit (give e.g. \"mm\" or \"m\")"))
+        }
+        None => {
+            let ext = file
+                .extension()
+                .map(|e| e.to_string_lossy().to_ascii_lowercase())
+                .unwrap_or_default();
+            if ext == "msh" || ext == "inp" {
+                Err(format!(
+                    "{} states no unit: give the length unit of its coordinates, e.g. `units = \"mm\"` under [mesh]",
+                    file.display()
+                ))
+            } else {
+                Ok(1.0)
+            }
+        }
+    }
 }
 
 fn formulation(p: &PartSpec) -> Result<Formulation, String> {
@@ -282,11 +319,23 @@ pub fn build_scene(spec: SceneSpec, path: &Path, src: &str) -> Result<Scene, Str
 /// [`build_scene`], reusing an already built phantom when the scene's `[mesh.phantom]` asks
 /// for the same parameters (campaigns build the phantom once for all their runs).
 pub fn build_scene_with(
-    mut spec: SceneSpec,
+    spec: SceneSpec,
     path: &Path,
     src: &str,
     prebuilt: Option<Phantom>,
 ) -> Result<Scene, String> {
+    super::def::assemble(resolve_scene(spec, path, src, prebuilt)?)
+}
+
+/// Resolve a parsed scene to SI ([`SceneDef`]): the mesh with its node sets, the parts' laws,
+/// boundary conditions, loads, settings, output and contact. [`super::def::assemble`] builds
+/// the model from it.
+pub fn resolve_scene(
+    mut spec: SceneSpec,
+    path: &Path,
+    src: &str,
+    prebuilt: Option<Phantom>,
+) -> Result<SceneDef, String> {
     let e = |key: &str, needle: Option<&str>, msg: &dyn std::fmt::Display| {
         err(path, src, key, needle, msg)
     };
@@ -306,7 +355,8 @@ pub fn build_scene_with(
             &format!("must lie in (0, 1], got {dt_factor}"),
         ));
     }
-    let (mut mesh, mut phantom) = read_mesh(&spec.mesh, path, src, prebuilt)?;
+    let mut notes = Vec::new();
+    let (mut mesh, mut phantom) = read_mesh(&spec.mesh, path, src, prebuilt, &mut notes)?;
     for (i, h) in spec.hands.iter_mut().enumerate() {
         place_hand(h, phantom.as_ref())
             .map_err(|m| e(&format!("hand[{i}]"), Some(&format!("\"{}\"", h.name)), &m))?;
@@ -421,9 +471,15 @@ pub fn build_scene_with(
         };
         let formulation =
             formulation(ps).map_err(|m| e(&key, Some(&format!("\"{pname}\"")), &m))?;
-        parts.push(Part {
+        let card = match spec.materials.get(&ps.material) {
+            Some(card) => card.clone(),
+            None => material::library::named(&ps.material)
+                .map_err(|m| e(&format!("{key}.material"), Some(&ps.material), &m))?,
+        };
+        parts.push(PartDef {
             name: pname.clone(),
             material,
+            spec: card,
             formulation,
         });
     }
@@ -528,13 +584,13 @@ pub fn build_scene_with(
             }
         }
     }
-    let mut v0: Option<Vec<[f64; 3]>> = None;
+    let mut initial_velocity = Vec::new();
     for (i, iv) in spec.initial_velocities.iter().enumerate() {
         let nodes = set(&iv.nodes, &format!("initial_velocity[{i}].nodes"))?;
-        let v = v0.get_or_insert_with(|| vec![[0.0; 3]; mesh.nodes.len()]);
-        for n in nodes {
-            v[n as usize] = [iv.velocity[0].0, iv.velocity[1].0, iv.velocity[2].0];
-        }
+        initial_velocity.push((
+            nodes,
+            [iv.velocity[0].0, iv.velocity[1].0, iv.velocity[2].0],
+        ));
     }
     // Output plan.
     let out = &spec.output;
@@ -636,64 +692,61 @@ pub fn build_scene_with(
     let relaxation = spec.relaxation.as_ref().map(|r| DynamicRelaxation {
         tolerance: r.tolerance.map(|x| x.0).unwrap_or(1e-10),
     });
-    let model = Model::build(mesh, parts, mass_scaling, dt_factor)
-        .map_err(|m| format!("{}: {m}", path.display()))?;
-    let dt0 = model.scaled_dt.min(model.initial_dt.0);
-    let settings = LoopSettings {
-        dt_factor,
-        bulk,
-        damping,
-        gravity,
-        relaxation,
-        dt_max: spec.run.dt_max.map(|t| t.0).unwrap_or(f64::INFINITY),
-        dt_min: spec.run.dt_min.map(|t| t.0).unwrap_or(1e-6 * dt0),
-        hourglass_limit: match spec.run.max_hourglass_ratio {
-            Some(r) if !(r.0 > 0.0) => {
-                return Err(format!(
-                    "{}: run.max_hourglass_ratio must be positive (got {})",
-                    path.display(),
-                    r.0
-                ))
-            }
-            Some(r) => Some(HourglassLimit {
-                ratio: r.0,
-                after: spec
-                    .run
-                    .hourglass_check_after
-                    .map(|t| t.0)
-                    .unwrap_or(0.1 * end_time),
-            }),
-            None => None,
-        },
+    let hourglass_guard = match spec.run.max_hourglass_ratio {
+        Some(r) if !(r.0 > 0.0) => {
+            return Err(format!(
+                "{}: run.max_hourglass_ratio must be positive (got {})",
+                path.display(),
+                r.0
+            ))
+        }
+        Some(r) => Some(HourglassGuard {
+            ratio: r.0,
+            after: spec.run.hourglass_check_after.map(|t| t.0),
+        }),
+        None => None,
     };
-    let want_stress = plan.needs_stress() || plan.probe.is_some();
-    let mut sim = Simulation::new(model, settings, constraints, loads, v0, want_stress)
-        .map_err(|m| format!("{}: {m}", path.display()))?;
-    let mut notes = Vec::new();
     // Contact exists only when the scene has indenters or hands.
-    if !spec.indenters.is_empty() || !spec.hands.is_empty() {
-        let stage = crate::contact_stage::build_stage(
-            &sim,
+    let contact = if !spec.indenters.is_empty() || !spec.hands.is_empty() {
+        Some(crate::contact_stage::resolve_contact(
+            &mesh,
             &spec.indenters,
             &spec.hands,
             spec.contact.as_ref(),
             path,
             src,
-            &mut notes,
-        )?;
-        sim.stages.push(Box::new(stage));
-    }
-    Ok(Scene {
-        sim,
-        end_time,
+        )?)
+    } else {
+        None
+    };
+    let setup = Setup {
+        parts,
+        constraints,
+        loads,
+        initial_velocity,
+        dt_factor,
+        dt_max: spec.run.dt_max.map(|t| t.0),
+        dt_min: spec.run.dt_min.map(|t| DtMin::Time(t.0)),
+        hourglass_guard,
+        bulk,
+        damping,
+        gravity,
+        relaxation,
+        mass_scaling,
         output: plan,
+        contact,
+    };
+    Ok(SceneDef {
         title: spec.run.title.clone().unwrap_or_else(|| {
             path.file_stem()
                 .map(|s| s.to_string_lossy().into_owned())
                 .unwrap_or_default()
         }),
         path: path.to_path_buf(),
+        end_time,
+        mesh,
         phantom,
+        setup,
         notes,
     })
 }

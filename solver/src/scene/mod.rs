@@ -6,6 +6,7 @@
 
 pub mod build;
 pub mod contact_spec;
+pub mod def;
 pub mod phantom_spec;
 pub mod spec;
 

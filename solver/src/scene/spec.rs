@@ -83,8 +83,11 @@ pub struct RunSpec {
 pub struct MeshSpec {
     /// `box` for the structured generator.
     pub generator: Option<String>,
-    /// A mesh file (`.vtu`), relative to the scene file.
+    /// A mesh file (`.vtu`, `.vtk`, `.msh`, `.inp`), relative to the scene file.
     pub file: Option<String>,
+    /// The length unit of the file's coordinates (`"mm"`, `"m"`, ...): required for Gmsh and
+    /// Abaqus files, which carry none; VTK files are read in m unless it says otherwise.
+    pub units: Option<String>,
     /// Box: lower corner.
     pub origin: Option<[Length; 3]>,
     /// Box: edge lengths.

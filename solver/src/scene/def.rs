@@ -1,0 +1,241 @@
+//! A scene resolved to SI, between its source file and the running [`Simulation`].
+//!
+//! Two readers produce a [`SceneDef`]: the TOML scene ([`super::build`]) and the LS-DYNA keyword
+//! deck (the `lsdyna` crate). [`assemble`] turns either into a runnable [`Scene`]: it builds the
+//! model (lumped masses, mass scaling, the initial stable step), the loop settings, the
+//! simulation and the contact stage. What the model needs before it exists (which faces are the
+//! contact surface, where a hand stands) is resolved here, so both readers share every rule.
+//!
+//! The assembled [`Scene`] keeps its [`Setup`], with the indenters as they run (hands turned
+//! into their two capsules and backed off the skin), so that a scene can be written out again
+//! (`palpa export --lsdyna`) from exactly what palpa runs.
+
+use super::build::{OutputPlan, Scene};
+use crate::bc::{Constraint, NodalLoad};
+use crate::element::{BulkViscosity, Formulation};
+use crate::mesh::Mesh;
+use crate::model::{MassScaling, Model, Part};
+use crate::phantom::Phantom;
+use crate::simulation::{DynamicRelaxation, HourglassLimit, LoopSettings, Simulation};
+use contact::{ContactParams, HandSpec, IndenterSpec};
+use material::{Material, MaterialSpec};
+use std::collections::HashSet;
+use std::path::PathBuf;
+
+/// One part: its law, the card it was built from, and its element formulation.
+#[derive(Clone, Debug)]
+pub struct PartDef {
+    /// Part name (as in the mesh).
+    pub name: String,
+    /// The built law.
+    pub material: Material,
+    /// The card the law was built from (SI values), kept for export.
+    pub spec: MaterialSpec,
+    /// Element formulation.
+    pub formulation: Formulation,
+}
+
+/// The smallest step before a run is stopped.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum DtMin {
+    /// A time (s).
+    Time(f64),
+    /// A fraction of the initial step (LS-DYNA `*CONTROL_TERMINATION` DTMIN).
+    Factor(f64),
+}
+
+/// The hourglass guard (see [`HourglassLimit`]); `after` defaults to 10 % of the end time.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct HourglassGuard {
+    /// Largest hourglass / internal energy.
+    pub ratio: f64,
+    /// From when it is checked (s).
+    pub after: Option<f64>,
+}
+
+/// A rigid indenter with the place its definition came from (for messages).
+#[derive(Clone, Debug)]
+pub struct IndenterDef {
+    /// The indenter (SI).
+    pub spec: IndenterSpec,
+    /// `FILE:LINE` (or `FILE`) of its definition.
+    pub origin: String,
+}
+
+/// A two-finger hand before it is placed against the skin.
+#[derive(Clone, Debug)]
+pub struct HandDef {
+    /// The hand (SI); `gap` is the given one, or 0.
+    pub hand: HandSpec,
+    /// Whether the scene gave `gap` (else a hand that starts inside the skin is backed off).
+    pub gap_given: bool,
+    /// Whether it was placed on a phantom location (then its travel is extended by the
+    /// back-off, so that the indentation beyond first contact is the requested one).
+    pub placed: bool,
+    /// `FILE:LINE` (or `FILE`) of its definition.
+    pub origin: String,
+}
+
+/// Which boundary faces of the mesh take part in contact: every boundary face, restricted by
+/// each selection that is given.
+#[derive(Clone, Debug, Default)]
+pub struct SurfaceSel {
+    /// Only faces whose four nodes are all marked (a node set).
+    pub nodes: Option<Vec<bool>>,
+    /// Only faces of elements of the marked parts.
+    pub parts: Option<Vec<bool>>,
+    /// Only these faces (sorted node ids), e.g. an LS-DYNA segment set.
+    pub faces: Option<HashSet<[u32; 4]>>,
+}
+
+/// The contact of a scene: rigid indenters against the boundary of the mesh.
+#[derive(Clone, Debug)]
+pub struct ContactDef {
+    /// Indenters (before assembly: those given as such; after: every one, hands included, in
+    /// history-column order).
+    pub indenters: Vec<IndenterDef>,
+    /// Hands still to be placed (empty after assembly).
+    pub hands: Vec<HandDef>,
+    /// The contact surface.
+    pub surface: SurfaceSel,
+    /// Penalty, friction and search settings; `design_dt = None` takes the run's initial step.
+    pub params: ContactParams,
+    /// Where the contact was defined and what selects its surface, for the message when the
+    /// selection leaves no face (e.g. "scene.toml: `contact`").
+    pub origin: String,
+    /// The hint given when no face is left.
+    pub empty_hint: String,
+}
+
+/// Everything but the mesh: what runs on it.
+#[derive(Clone, Debug)]
+pub struct Setup {
+    /// Parts, in the order of the mesh's part names.
+    pub parts: Vec<PartDef>,
+    /// Kinematic conditions.
+    pub constraints: Vec<Constraint>,
+    /// Nodal loads.
+    pub loads: Vec<NodalLoad>,
+    /// Initial velocities, applied in order (a later one overrides an earlier one on a node).
+    pub initial_velocity: Vec<(Vec<u32>, [f64; 3])>,
+    /// Time-step safety factor.
+    pub dt_factor: f64,
+    /// Largest step (s).
+    pub dt_max: Option<f64>,
+    /// Smallest step before the run stops (default: 1e-6 of the initial step).
+    pub dt_min: Option<DtMin>,
+    /// Hourglass guard.
+    pub hourglass_guard: Option<HourglassGuard>,
+    /// Bulk viscosity.
+    pub bulk: Option<BulkViscosity>,
+    /// Mass-proportional damping (1/s).
+    pub damping: Option<f64>,
+    /// Gravity (m/s^2).
+    pub gravity: Option<[f64; 3]>,
+    /// Dynamic relaxation.
+    pub relaxation: Option<DynamicRelaxation>,
+    /// Selective mass scaling.
+    pub mass_scaling: Option<MassScaling>,
+    /// Output requests.
+    pub output: OutputPlan,
+    /// Contact, when the scene has indenters.
+    pub contact: Option<ContactDef>,
+}
+
+/// A scene resolved to SI, ready to [`assemble`].
+pub struct SceneDef {
+    /// Title.
+    pub title: String,
+    /// Source file.
+    pub path: PathBuf,
+    /// End time (s).
+    pub end_time: f64,
+    /// The mesh, with its node and element sets.
+    pub mesh: Mesh,
+    /// The phantom the mesh came from (its `mesh` field emptied).
+    pub phantom: Option<Phantom>,
+    /// What runs on the mesh.
+    pub setup: Setup,
+    /// Things the reader adjusted that the user should know (printed before the run).
+    pub notes: Vec<String>,
+}
+
+/// Build the model, the simulation and the contact stage of a resolved scene.
+pub fn assemble(def: SceneDef) -> Result<Scene, String> {
+    let SceneDef {
+        title,
+        path,
+        end_time,
+        mesh,
+        phantom,
+        mut setup,
+        mut notes,
+    } = def;
+    let n_nodes = mesh.nodes.len();
+    let parts: Vec<Part> = setup
+        .parts
+        .iter()
+        .map(|p| Part {
+            name: p.name.clone(),
+            material: p.material.clone(),
+            formulation: p.formulation,
+        })
+        .collect();
+    let model = Model::build(mesh, parts, setup.mass_scaling, setup.dt_factor)
+        .map_err(|m| format!("{}: {m}", path.display()))?;
+    let dt0 = model.scaled_dt.min(model.initial_dt.0);
+    let settings = LoopSettings {
+        dt_factor: setup.dt_factor,
+        bulk: setup.bulk,
+        damping: setup.damping,
+        gravity: setup.gravity,
+        relaxation: setup.relaxation,
+        dt_max: setup.dt_max.unwrap_or(f64::INFINITY),
+        dt_min: match setup.dt_min {
+            None => 1e-6 * dt0,
+            Some(DtMin::Time(t)) => t,
+            Some(DtMin::Factor(f)) => f * dt0,
+        },
+        hourglass_limit: setup.hourglass_guard.map(|g| HourglassLimit {
+            ratio: g.ratio,
+            after: g.after.unwrap_or(0.1 * end_time),
+        }),
+    };
+    let v0 = if setup.initial_velocity.is_empty() {
+        None
+    } else {
+        let mut v = vec![[0.0; 3]; n_nodes];
+        for (nodes, vel) in &setup.initial_velocity {
+            for &n in nodes {
+                v[n as usize] = *vel;
+            }
+        }
+        Some(v)
+    };
+    let want_stress = setup.output.needs_stress() || setup.output.probe.is_some();
+    let mut sim = Simulation::new(
+        model,
+        settings,
+        setup.constraints.clone(),
+        setup.loads.clone(),
+        v0,
+        want_stress,
+    )
+    .map_err(|m| format!("{}: {m}", path.display()))?;
+    if let Some(c) = setup.contact.as_mut() {
+        if !c.indenters.is_empty() || !c.hands.is_empty() {
+            let stage = crate::contact_stage::build_stage(&sim, c, &path, &mut notes)?;
+            sim.stages.push(Box::new(stage));
+        }
+    }
+    Ok(Scene {
+        sim,
+        end_time,
+        output: setup.output.clone(),
+        title,
+        path,
+        phantom,
+        notes,
+        setup,
+    })
+}

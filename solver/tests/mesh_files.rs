@@ -1,0 +1,348 @@
+//! Meshes written by other tools (tests/meshes/, made by tests/meshes/make_meshes.py with VTK
+//! 9.7, meshio 5.3 and Gmsh 4.15): every encoding reads to the same block, 30 x 20 x 20 mm in
+//! 12 hexahedra and two parts of equal volume, with the part names, node sets and element sets
+//! each format carries; cells palpa does not mesh are refused with their counts.
+
+mod common;
+
+use solver::mesh_io::read_mesh;
+use solver::Mesh;
+use std::path::PathBuf;
+
+fn file(name: &str) -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("../tests/meshes")
+        .join(name)
+}
+
+/// Volume of a hexahedron (m^3) by its exact trilinear volume (sum over 2x2x2 Gauss points).
+fn volume(m: &Mesh, e: usize) -> f64 {
+    let x: [[f64; 3]; 8] = std::array::from_fn(|a| m.nodes[m.elements[e][a] as usize]);
+    solver::hex::element_geometry(&x).unwrap().volume
+}
+
+/// The block: its bounds, 12 hexahedra, total volume 1.2e-5 m^3, and per part (by name) the
+/// volume 6e-6 m^3.
+fn check_block(m: &Mesh, names: [&str; 2]) {
+    assert_eq!(m.elements.len(), 12);
+    assert_eq!(m.nodes.len(), 36);
+    let (lo, hi) = m.bounds();
+    for k in 0..3 {
+        assert!(lo[k].abs() < 1e-12, "{lo:?}");
+    }
+    assert!(
+        (hi[0] - 0.030).abs() < 1e-12
+            && (hi[1] - 0.020).abs() < 1e-12
+            && (hi[2] - 0.020).abs() < 1e-12,
+        "{hi:?}"
+    );
+    let total: f64 = (0..12).map(|e| volume(m, e)).sum();
+    assert!((total - 1.2e-5).abs() < 1e-15, "total volume {total}");
+    assert_eq!(m.part_names, names, "part names");
+    for p in 0..2 {
+        let v: f64 = (0..12)
+            .filter(|&e| m.element_part[e] == p as u32)
+            .map(|e| volume(m, e))
+            .sum();
+        assert!(
+            (v - 6e-6).abs() < 1e-15,
+            "part {} volume {v}",
+            m.part_names[p]
+        );
+    }
+}
+
+#[test]
+fn vtk_xml_in_every_encoding() {
+    for f in [
+        "vtk-appended-zlib.vtu",
+        "vtk-binary-base64.vtu",
+        "vtk-ascii.vtu",
+        "vtk-appended-lz4.vtu",
+        "vtk-appended-plain.vtu",
+    ] {
+        let m = read_mesh(&file(f), 1.0).unwrap_or_else(|e| panic!("{f}: {e}"));
+        check_block(&m.mesh, ["left", "right"]);
+        assert!(m.notes.is_empty(), "{f}: {:?}", m.notes);
+    }
+}
+
+#[test]
+fn vtk_legacy_ascii_and_binary() {
+    for f in ["vtk-legacy-ascii.vtk", "vtk-legacy-binary.vtk"] {
+        let m = read_mesh(&file(f), 1.0).unwrap_or_else(|e| panic!("{f}: {e}"));
+        check_block(&m.mesh, ["left", "right"]);
+    }
+}
+
+#[test]
+fn meshio_default_ascii_and_legacy() {
+    // meshio keeps no part names: the parts are named by their id.
+    for f in [
+        "meshio-default.vtu",
+        "meshio-ascii.vtu",
+        "meshio-legacy.vtk",
+    ] {
+        let m = read_mesh(&file(f), 1.0).unwrap_or_else(|e| panic!("{f}: {e}"));
+        check_block(&m.mesh, ["part_1", "part_2"]);
+    }
+}
+
+#[test]
+fn gmsh_ascii_and_binary_with_physical_groups() {
+    for f in ["gmsh.msh", "gmsh-binary.msh"] {
+        let m = read_mesh(&file(f), 1.0).unwrap_or_else(|e| panic!("{f}: {e}"));
+        let mesh = &m.mesh;
+        assert_eq!(mesh.elements.len(), 12, "{f}");
+        assert_eq!(mesh.part_names, ["left", "right"], "{f}");
+        let total: f64 = (0..12).map(|e| volume(mesh, e)).sum();
+        assert!((total - 1.2e-5).abs() < 1e-15, "{f}: {total}");
+        // Gmsh's "left" volume is the 10 mm slab (4 hexahedra), "right" the 20 mm one (8).
+        let left = mesh.element_part.iter().filter(|&&p| p == 0).count();
+        assert_eq!(left, 4, "{f}");
+        // The physical surface x = 0: a 3 x 3 grid of nodes, all on x = 0.
+        let xmin = &mesh.node_sets["xmin"];
+        assert_eq!(xmin.len(), 9, "{f}");
+        assert!(
+            xmin.iter().all(|&n| mesh.nodes[n as usize][0] == 0.0),
+            "{f}"
+        );
+        // The file's quadrilaterals (of the surface) are reported, not meshed.
+        assert!(
+            m.notes.iter().any(|n| n.contains("quadrilaterals")),
+            "{f}: {:?}",
+            m.notes
+        );
+    }
+    let e = read_mesh(&file("gmsh.msh"), 1e-3)
+        .map(|m| m.mesh.bounds().1[0])
+        .unwrap();
+    assert!((e - 3e-5).abs() < 1e-18, "units scale coordinates: {e}");
+}
+
+#[test]
+fn abaqus_part_sections_and_sets_in_mm() {
+    let m = read_mesh(&file("abaqus.inp"), 1e-3).unwrap_or_else(|e| panic!("{e}"));
+    check_block(&m.mesh, ["FAT", "MUSCLE"]);
+    let xmin = &m.mesh.node_sets["XMIN"];
+    assert_eq!(xmin.len(), 9);
+    assert!(xmin.iter().all(|&n| m.mesh.nodes[n as usize][0] == 0.0));
+    assert_eq!(m.mesh.element_sets["ALL"].len(), 12);
+    assert_eq!(m.mesh.element_sets["FAT"].len(), 6);
+}
+
+fn refusal(name: &str) -> String {
+    match read_mesh(&file(name), 1.0) {
+        Ok(_) => panic!("{name} was accepted"),
+        Err(e) => {
+            assert!(e.contains(name), "the message names the file: {e}");
+            e
+        }
+    }
+}
+
+#[test]
+fn refusals_name_what_is_wrong() {
+    let e = refusal("tetra.vtu");
+    assert!(e.contains("no hexahedra but 12 tetrahedra"), "{e}");
+    let e = refusal("mixed.vtu");
+    assert!(e.contains("11 hexahedra and 1 wedge"), "{e}");
+    let e = refusal("inverted.vtu");
+    assert!(
+        e.contains("1 of 12 hexahedra are inverted") && e.contains("cell 0"),
+        "{e}"
+    );
+    let e = refusal("does-not-exist.vtu");
+    assert!(e.contains("does not exist"), "{e}");
+    // A file of another kind, and a Gmsh file of the old format.
+    let dir = tempfile::tempdir().unwrap();
+    let stl = dir.path().join("part.stl");
+    std::fs::write(&stl, "solid x\nendsolid x\n").unwrap();
+    let e = read_mesh(&stl, 1.0).err().unwrap();
+    assert!(e.contains(".stl") && e.contains(".msh"), "{e}");
+    let old = dir.path().join("old.msh");
+    std::fs::write(&old, "$MeshFormat\n2.2 0 8\n$EndMeshFormat\n").unwrap();
+    let e = read_mesh(&old, 1.0).err().unwrap();
+    assert!(e.contains("format 2.2") && e.contains("4.1"), "{e}");
+    let inp = dir.path().join("tet.inp");
+    std::fs::write(
+        &inp,
+        "*Node\n1, 0, 0, 0\n2, 1, 0, 0\n3, 0, 1, 0\n4, 0, 0, 1\n*Element, type=C3D4\n1, 1, 2, 3, 4\n",
+    )
+    .unwrap();
+    let e = read_mesh(&inp, 1.0).err().unwrap();
+    assert!(e.contains("1 C3D4 elements"), "{e}");
+    let bad = dir.path().join("bad.inp");
+    std::fs::write(&bad, "*Node\n1, 0, 0, zero\n").unwrap();
+    let e = read_mesh(&bad, 1.0).err().unwrap();
+    assert!(
+        e.contains("bad.inp:2") && e.contains("`zero` is not a number"),
+        "{e}"
+    );
+}
+
+/// Uniaxial compression of the block on rollers, 5 % in x over 20 ms (neo-Hookean, both parts
+/// the same material), from the mesh given by `mesh` (a `[mesh]` table body); the final x0
+/// support reaction (N).
+fn compression(mesh: &str, parts: [&str; 2]) -> f64 {
+    let src = format!(
+        r#"
+[run]
+end_time = "25 ms"
+[mesh]
+{mesh}
+[materials.m]
+law = "neo_hookean"
+density = "1000 kg/m^3"
+youngs_modulus = "1 MPa"
+poisson_ratio = 0.3
+[[part]]
+name = "{}"
+material = "m"
+[[part]]
+name = "{}"
+material = "m"
+[node_sets.x0]
+plane_axis = "x"
+plane_value = "0 mm"
+[node_sets.x1]
+plane_axis = "x"
+plane_value = "30 mm"
+[node_sets.y0]
+plane_axis = "y"
+plane_value = "0 mm"
+[node_sets.z0]
+plane_axis = "z"
+plane_value = "0 mm"
+[[boundary]]
+nodes = "x0"
+symmetry = "x"
+[[boundary]]
+nodes = "y0"
+symmetry = "y"
+[[boundary]]
+nodes = "z0"
+symmetry = "z"
+[[boundary]]
+nodes = "x1"
+displacement = {{ x = {{ kind = "smooth_step", value = "-1.5 mm", end = "20 ms" }} }}
+[output]
+history_interval = "1 ms"
+reactions = ["x0"]
+"#,
+        parts[0], parts[1]
+    );
+    let mut scene = common::scene_from_str(&src);
+    let (cols, rows) = common::run_to_end(&mut scene, "mesh-file");
+    *solver::output::history::column(&cols, &rows, "x0_reaction_x")
+        .unwrap()
+        .last()
+        .unwrap()
+}
+
+/// Closed form of the neo-Hookean bar in uniaxial stress (as in compression_block.rs).
+fn closed_form(e: f64, nu: f64, lx: f64, area: f64) -> f64 {
+    let mu = e / (2.0 * (1.0 + nu));
+    let lam = e * nu / ((1.0 + nu) * (1.0 - 2.0 * nu));
+    let s22 = |lt: f64| mu * (1.0 - 1.0 / (lt * lt)) + lam * (lx * lt * lt).ln() / (lt * lt);
+    let mut lt = 1.0;
+    for _ in 0..60 {
+        let h = 1e-7;
+        lt -= s22(lt) / ((s22(lt + h) - s22(lt - h)) / (2.0 * h));
+    }
+    let j = lx * lt * lt;
+    -lx * (mu * (1.0 - 1.0 / (lx * lx)) + lam * j.ln() / (lx * lx)) * area
+}
+
+#[test]
+fn every_file_runs_to_the_box_twin_and_the_closed_form() {
+    let twin = compression(
+        "generator = \"box\"\nsize = [\"30 mm\", \"20 mm\", \"20 mm\"]\ndivisions = [3, 2, 2]\npart = \"a\"",
+        ["a", "a"],
+    );
+    let exact = closed_form(1e6, 0.3, 0.95, 4e-4);
+    let rel = (twin - exact) / exact;
+    println!(
+        "box twin {twin:.9} N, closed form {exact:.9} N ({:+.3e})",
+        rel
+    );
+    assert!(rel.abs() < 5e-3, "twin {twin} vs closed form {exact}");
+    let cases: [(&str, &str, [&str; 2]); 7] = [
+        ("vtk-appended-zlib.vtu", "", ["left", "right"]),
+        ("vtk-legacy-binary.vtk", "", ["left", "right"]),
+        ("meshio-default.vtu", "", ["part_1", "part_2"]),
+        ("meshio-ascii.vtu", "", ["part_1", "part_2"]),
+        ("gmsh.msh", "units = \"m\"", ["left", "right"]),
+        ("gmsh-binary.msh", "units = \"m\"", ["left", "right"]),
+        ("abaqus.inp", "units = \"mm\"", ["FAT", "MUSCLE"]),
+    ];
+    for (f, units, parts) in cases {
+        let r = compression(&format!("file = \"../tests/meshes/{f}\"\n{units}"), parts);
+        let d = (r - twin) / twin;
+        println!("{f}: {r:.9} N, {d:+.2e} against the box twin");
+        assert!(d.abs() < 1e-9, "{f}: {r} against the twin's {twin}");
+    }
+}
+
+/// palpa's own frames: zlib-compressed, the part names in the field data; read back, the mesh
+/// is the same bit for bit, names included. The indenter file holds the surfaces and names.
+#[test]
+fn palpa_frames_keep_part_names_and_draw_indenters() {
+    use solver::output::vtk::{write_surfaces, write_vtu, Frame, RigidSurface};
+    let mut mesh = solver::generate::box_mesh(
+        &solver::generate::BoxSpec {
+            size: [0.03, 0.02, 0.01],
+            divisions: [3, 2, 1],
+            grading: [1.3, 1.0, 1.0],
+            ..Default::default()
+        },
+        "fat",
+    )
+    .unwrap();
+    mesh.part_names = vec!["fat".into(), "liver tissue".into()];
+    mesh.element_part = (0..6).map(|e| (e % 2) as u32).collect();
+    let dir = tempfile::tempdir().unwrap();
+    let p = dir.path().join("frame.vtu");
+    let frame = Frame {
+        part: true,
+        ..Default::default()
+    };
+    write_vtu(&p, &mesh, &frame, "t").unwrap();
+    let text = std::fs::read(&p).unwrap();
+    assert!(
+        String::from_utf8_lossy(&text[..300]).contains("compressor=\"vtkZLibDataCompressor\""),
+        "frames are compressed"
+    );
+    let back = read_mesh(&p, 1.0).unwrap().mesh;
+    assert_eq!(back.nodes, mesh.nodes);
+    assert_eq!(back.elements, mesh.elements);
+    assert_eq!(back.element_part, mesh.element_part);
+    assert_eq!(back.part_names, mesh.part_names);
+
+    let sq = RigidSurface {
+        name: "finger".into(),
+        vertices: vec![[0.0; 3], [1.0, 0.0, 0.0], [1.0, 1.0, 0.0], [0.0, 1.0, 0.0]],
+        polygons: vec![vec![0, 1, 2, 3], vec![0, 2, 3]],
+        displacement: [0.0, 0.0, -1e-3],
+    };
+    let s = dir.path().join("indenters.vtu");
+    write_surfaces(
+        &s,
+        &[
+            sq.clone(),
+            RigidSurface {
+                name: "thumb".into(),
+                ..sq
+            },
+        ],
+        "t",
+    )
+    .unwrap();
+    let names = solver::mesh_io::xml::field_strings(&std::fs::read(&s).unwrap(), "indenter_names");
+    assert_eq!(names.unwrap(), ["finger", "thumb"]);
+    let e = read_mesh(&s, 1.0).err().unwrap();
+    assert!(
+        e.contains("no hexahedra") && e.contains("2 quadrilaterals, 2 triangles"),
+        "{e}"
+    );
+}
