@@ -1,5 +1,6 @@
 //! The assembled model: element groups in struct-of-arrays form, lumped masses, selective mass
-//! scaling, and the node-to-element gather table for race-free parallel assembly.
+//! scaling, and the chunk colouring that lets the element loop add its forces into the nodal array
+//! in parallel without a race.
 //!
 //! Elements are grouped by part (one law and one formulation per group). Each group stores
 //! its reference data contiguously: connectivity, mean or centre gradients, volumes,
@@ -157,9 +158,11 @@ pub struct Group {
     pub history: Vec<F64x8>,
     /// Density scale factors from mass scaling (empty if none).
     pub density_scale: Vec<f64>,
-    /// Offset of this group's elements in the element-force slot buffer (a multiple of
-    /// [`LANES`]: the slots of a batch are one lane vector per force component and node).
-    pub slot_offset: usize,
+    /// The group's chunks ([`CHUNK`] elements each) by colour: no two chunks of one colour share
+    /// a node, so the chunks of a colour add their element forces straight into the nodal
+    /// force array in parallel without a race, and every node receives its contributions in
+    /// the same order (colour, then element order within its chunk) on any thread count.
+    pub colours: Vec<Vec<u32>>,
     /// Scratch: per-chunk partial results.
     pub chunks: Vec<ChunkOut>,
     /// Eroded flags (empty unless the law can fail).
@@ -199,6 +202,48 @@ impl Group {
             .map(|(le, ip)| self.history_value(le, ip, k, history_len))
             .collect()
     }
+}
+
+/// Colour the chunks of a group (elements in chunks of [`CHUNK`], in order) so that no two chunks
+/// of one colour share a node: greedy, each chunk taking the lowest colour none of the earlier
+/// chunks it shares a node with has. A mesh numbered for locality (slabs of elements) needs a few
+/// colours; each colour lists its chunks in ascending order.
+fn colour_chunks(conn: &[[u32; 8]], n_nodes: usize) -> Vec<Vec<u32>> {
+    let n_chunks = conn.len().div_ceil(CHUNK);
+    // For each node, the chunks (ascending) that touch it.
+    let mut node_chunks: Vec<Vec<u32>> = vec![Vec::new(); n_nodes];
+    for (e, c) in conn.iter().enumerate() {
+        let ci = (e / CHUNK) as u32;
+        for &n in c {
+            let list = &mut node_chunks[n as usize];
+            if list.last() != Some(&ci) {
+                list.push(ci);
+            }
+        }
+    }
+    let mut colour = vec![u32::MAX; n_chunks];
+    let mut colours: Vec<Vec<u32>> = Vec::new();
+    let mut taken: Vec<bool> = Vec::new();
+    for ci in 0..n_chunks {
+        taken.iter_mut().for_each(|t| *t = false);
+        for c in &conn[ci * CHUNK..((ci + 1) * CHUNK).min(conn.len())] {
+            for &n in c {
+                for &other in &node_chunks[n as usize] {
+                    if (other as usize) < ci {
+                        taken[colour[other as usize] as usize] = true;
+                    }
+                }
+            }
+        }
+        let k = taken.iter().position(|t| !t).unwrap_or(taken.len());
+        if k == colours.len() {
+            colours.push(Vec::new());
+            taken.push(false);
+        }
+        colour[ci] = k as u32;
+        colours[k].push(ci as u32);
+    }
+    colours
 }
 
 /// Lane vectors of per-element data, batch by batch; lanes past the end repeat the last element.
@@ -349,13 +394,6 @@ pub struct Model {
     pub mass: Vec<f64>,
     /// Per-part mass report.
     pub part_mass: Vec<PartMass>,
-    /// Gather table: for node n, entries gather_idx[gather_ptr[n]..gather_ptr[n+1]], each
-    /// 8 * element slot + local node.
-    pub gather_ptr: Vec<u32>,
-    /// Gather entries.
-    pub gather_idx: Vec<u32>,
-    /// Total element slots.
-    pub n_slots: usize,
     /// Initial critical step without mass scaling (s), and its element.
     pub initial_dt: (f64, u32),
     /// Initial critical step with mass scaling (s).
@@ -427,7 +465,6 @@ impl Model {
                 ..Default::default()
             })
             .collect();
-        let mut slot_offset = 0;
         let mut initial_dt = (f64::INFINITY, 0u32);
         // The target step; a multiple of the initial step needs that step first.
         let fixed_target = match mass_scaling.map(|m| m.target) {
@@ -463,7 +500,7 @@ impl Model {
                 history_stride: stride,
                 history: vec![F64x8::splat(0.0); stride * n.div_ceil(LANES)],
                 density_scale: Vec::new(),
-                slot_offset,
+                colours: Vec::new(),
                 chunks: vec![ChunkOut::default(); n.div_ceil(CHUNK)],
                 eroded: Vec::new(),
                 dt_kappa: 1.0,
@@ -582,7 +619,7 @@ impl Model {
                     *h = F64x8::splat(h0[k % stride % hl]);
                 }
             }
-            slot_offset += n.div_ceil(LANES) * LANES;
+            g.colours = colour_chunks(&g.conn, mesh.nodes.len());
             groups.push(g);
         }
         if let Some(ms) = mass_scaling {
@@ -606,39 +643,12 @@ impl Model {
                 "node {n} belongs to no element (zero mass); remove it"
             )));
         }
-        // Gather table.
-        let nn = mesh.nodes.len();
-        let mut count = vec![0u32; nn + 1];
-        for g in &groups {
-            for c in &g.conn {
-                for &n in c {
-                    count[n as usize + 1] += 1;
-                }
-            }
-        }
-        for i in 0..nn {
-            count[i + 1] += count[i];
-        }
-        let mut fill = count.clone();
-        let mut idx = vec![0u32; count[nn] as usize];
-        for g in &groups {
-            for (k, c) in g.conn.iter().enumerate() {
-                let slot = g.slot_offset + k;
-                for (a, &n) in c.iter().enumerate() {
-                    idx[fill[n as usize] as usize] = (slot * 8 + a) as u32;
-                    fill[n as usize] += 1;
-                }
-            }
-        }
         Ok(Model {
             mesh,
             parts,
             groups,
             mass,
             part_mass,
-            gather_ptr: count,
-            gather_idx: idx,
-            n_slots: slot_offset,
             initial_dt,
             scaled_dt,
             mass_scaling: match (mass_scaling, fixed_target) {
@@ -651,12 +661,6 @@ impl Model {
         })
     }
 
-    /// A zeroed element-force buffer for [`crate::forces::element_loop`]: one batch slot (a lane
-    /// vector per force component and node) per [`LANES`] slots.
-    pub fn slot_buffer(&self) -> Vec<Nodal<F64x8>> {
-        vec![[[F64x8::zero(); 8]; 3]; self.n_slots / LANES]
-    }
-
     /// Total physical mass (kg).
     pub fn physical_mass(&self) -> f64 {
         self.part_mass.iter().map(|p| p.physical).sum()
@@ -664,14 +668,5 @@ impl Model {
     /// Total added mass (kg).
     pub fn added_mass(&self) -> f64 {
         self.part_mass.iter().map(|p| p.added).sum()
-    }
-    /// Global element id of a slot.
-    pub fn slot_element(&self, slot: usize) -> u32 {
-        for g in &self.groups {
-            if slot >= g.slot_offset && slot < g.slot_offset + g.elements.len() {
-                return g.elements[slot - g.slot_offset];
-            }
-        }
-        u32::MAX
     }
 }

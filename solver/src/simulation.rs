@@ -23,7 +23,7 @@
 
 use crate::bc::{Constraint, Kinematic, NodalLoad};
 use crate::element::{BulkViscosity, StepInput};
-use crate::forces::{element_loop, gather, ElementTotals};
+use crate::forces::{element_loop, ElementTotals};
 use crate::model::{Model, SolverError};
 use rayon::prelude::*;
 use std::time::{Duration, Instant};
@@ -238,7 +238,6 @@ pub struct Simulation {
     pub reaction: Vec<[f64; 3]>,
     /// Cauchy stress per element at the last output step (Pa), if requested.
     pub stress: Option<Vec<[f64; 6]>>,
-    slots: Vec<crate::element::Nodal<material::real::F64x8>>,
     dof_code: Vec<u32>,
     prescribed: Vec<Prescribed>,
     loads: Vec<NodalLoad>,
@@ -291,7 +290,6 @@ pub struct Erosion {
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum Stage {
     Elements,
-    Gather,
     Loads,
     Contact,
     Update,
@@ -347,7 +345,6 @@ impl Simulation {
                 .map(|&m| [m * g[0], m * g[1], m * g[2]])
                 .collect()
         });
-        let slots = model.slot_buffer();
         let ne = model.mesh.elements.len();
         let mut v = initial_velocity.unwrap_or_else(|| vec![[0.0; 3]; nn]);
         if v.len() != nn {
@@ -369,7 +366,6 @@ impl Simulation {
             .sum();
         let timers = [
             "element forces",
-            "assembly",
             "loads",
             "contact",
             "update",
@@ -394,7 +390,6 @@ impl Simulation {
             } else {
                 None
             },
-            slots,
             dof_code,
             prescribed,
             loads,
@@ -431,7 +426,6 @@ impl Simulation {
     pub fn active_stages(&self) -> Vec<String> {
         let mut s = vec![
             "element forces".to_string(),
-            "assembly".into(),
             "central-difference update".into(),
         ];
         if self.settings.bulk.is_some() {
@@ -502,7 +496,7 @@ impl Simulation {
             &self.u,
             &self.v,
             &input,
-            &mut self.slots,
+            &mut self.f_int,
             stress,
         );
         self.timers[Stage::Elements as usize].time += t0.elapsed();
@@ -529,9 +523,6 @@ impl Simulation {
             self.dt_next = self.settings.dt_factor * tot.dt_min;
             self.dt_element = tot.dt_elem;
         }
-        self.time_stage(Stage::Gather as usize, |s| {
-            gather(&s.model, &s.slots, &mut s.f_int)
-        });
         Ok(())
     }
 

@@ -46,7 +46,7 @@ fn max_stress(form: Formulation) -> f64 {
         })
         .collect();
     let v = vec![[0.0; 3]; u.len()];
-    let mut slots = model.slot_buffer();
+    let mut force = vec![[0.0; 3]; u.len()];
     let mut stress = vec![[0.0; 6]; model.mesh.elements.len()];
     let nodes = model.mesh.nodes.clone();
     let input = StepInput {
@@ -62,7 +62,7 @@ fn max_stress(form: Formulation) -> f64 {
         &u,
         &v,
         &input,
-        &mut slots,
+        &mut force,
         Some(&mut stress),
     )
     .unwrap();

@@ -20,8 +20,8 @@
 //!
 //! The memory roof: a STREAM-style triad `a = b + s c` over 3 x 64 MB, run on the same threads
 //! just before each case, gives the bandwidth; the bytes a step moves per element (its reference
-//! data, history read and written, element-force slots written and gathered, the gather table,
-//! and nodal arrays: three gathered and about seven swept by the update, per node) divided into
+//! data, history read and written, and nodal arrays: three gathered, the force array added into
+//! and about seven swept by the update, per node) divided into
 //! it give the case's roof in element-cycles per second, and the table prints the fraction of
 //! that roof the case reaches. The bytes are a count of the arrays the step touches, not a
 //! hardware measurement: cache reuse of the gathered nodal data can beat the roof.
@@ -140,8 +140,7 @@ fn triad_bandwidth() -> f64 {
 }
 
 /// Bytes one step moves per element (module doc): reference data and history of every group,
-/// element-force slots (written, then read by the gather), the gather table, and 10 nodal
-/// arrays of 24 bytes.
+/// and 11 nodal arrays of 24 bytes (the force array is read and written by the element loop).
 fn step_bytes_per_element(m: &solver::model::Model) -> f64 {
     let mut bytes = 0usize;
     for g in &m.groups {
@@ -153,7 +152,7 @@ fn step_bytes_per_element(m: &solver::model::Model) -> f64 {
             + 2 * std::mem::size_of_val(g.history.as_slice())
             + 8 * g.density_scale.len();
     }
-    bytes += 2 * m.n_slots * 24 * 8 + 4 * m.gather_idx.len() + 10 * 24 * m.mesh.nodes.len();
+    bytes += 11 * 24 * m.mesh.nodes.len();
     bytes as f64 / m.mesh.elements.len() as f64
 }
 

@@ -97,7 +97,7 @@ pub fn check(path: &Path, deck: &DeckArgs) -> Result<(), String> {
         })
         .sum();
     let nodal = mesh.nodes.len() * 8 * (3 * 7 + 1);
-    let bytes = ref_data + hist * 8 + nodal + m.n_slots * 24 * 8 + m.gather_idx.len() * 4;
+    let bytes = ref_data + hist * 8 + nodal;
     println!(
         "  memory estimate: {:.1} MiB (history {:.1} MiB)",
         bytes as f64 / 1048576.0,
