@@ -4,7 +4,7 @@
 //! The cards are stored exactly as an LS-DYNA user would type them, in the paper's
 //! kg-mm-ms-GPa unit system (`"1.05e-6 kg/mm^3"`, `"8.914e-8 GPa"`, `"0.1 1/ms"`), and go through
 //! the same parsing and unit conversion as a scene's own cards, so the library doubles as a test
-//! of the unit handling. Values: `/shared/reference/paper-facts.md` (liver: Ogden eq. 1 + Prony
+//! of the unit handling. Values: `docs/paper.md` (liver: Ogden eq. 1 + Prony
 //! eqs. 2-3; flesh: simplified rubber/foam; ribs: piecewise-linear plasticity).
 
 use crate::spec::MaterialSpec;

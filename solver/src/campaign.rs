@@ -10,7 +10,7 @@
 //! failed run and is redone from scratch.
 //!
 //! # The file
-//! Every key is optional; the defaults are the paper's protocol (`shared/reference/paper-facts.md`):
+//! Every key is optional; the defaults are the paper's protocol (`docs/paper.md`):
 //! the 25 raster points P01..P25 for training, A, B, C for testing, 15 mm in 25 ms, a sample every
 //! 5 ms, on the reduced phantom with the paper's 3 mm voxels ([`CAMPAIGN_VOXEL`]) and 25 mm of
 //! subcutaneous fat ([`CAMPAIGN_FAT_THICKNESS`]). Quantities take units as in scene files,

@@ -1,5 +1,5 @@
 //! One two-finger palpation of the abdomen phantom, as the reference study ran it
-//! (`shared/reference/paper-facts.md`): the reduced phantom, the paper's three tissues
+//! (`docs/paper.md`): the reduced phantom, the paper's three tissues
 //! (`paper:liver`, `paper:flesh`, `paper:ribs`), two rigid capsule fingers pressed 15 mm along
 //! the inward skin normal in 25 ms with a smooth ramp, penalty contact on the anterior skin,
 //! the back fixed and rollers on the cut planes, and the ROI's stresses sampled every 5 ms.

@@ -9,7 +9,7 @@ over those between two neighbours. It asks whether averaging the two model class
 without the test locations, would beat the GP alone.
 
 The GP learns the principal stress by default (`--gp-target principal`, the GP this study was
-run with, see the README); `--gp-target tensor` blends the stress-tensor GP instead.
+run with, see docs/surrogate.md); `--gp-target tensor` blends the stress-tensor GP instead.
 
     python surrogate/scripts/cv_ensemble.py CAMPAIGN_DIR [--palpa target/release/palpa] [--work DIR] [--gp-target T]
     (needs numpy; about 12 s of MLP training per fold on 2 cores)

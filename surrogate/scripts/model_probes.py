@@ -1,6 +1,6 @@
 """Probes of surrogate model classes on a campaign's dataset, scored by held-out Fit (paper eq. 5).
 
-These are the numpy / scikit-learn prototypes behind the README's "what I measured" list. None of
+These are the numpy / scikit-learn prototypes behind docs/surrogate.md and docs/campaigns.md. None of
 them is a palpa model; each asks whether a different model class would lift the held-out Fit
 above what `palpa train` gives on the same data.
 

@@ -11,7 +11,7 @@
 //! location's own mean; the overall figure pools all test samples (the paper's 92.64 % is such an
 //! overall figure over its three test locations A, B, C).
 //!
-//! Source: the 2022 abdomen-palpation article summarised in `shared/reference/paper-facts.md`.
+//! Source: the 2022 abdomen-palpation article summarised in `docs/paper.md`.
 
 use ndarray::ArrayView2;
 

@@ -1,7 +1,7 @@
 //! Real-time stress surrogates for palpation: datasets in, trained models and predictions out.
 //!
 //! The reference study (a 2022 abdomen-palpation article, summarised in
-//! `shared/reference/paper-facts.md`) trained a multilayer perceptron mapping the finger's
+//! `docs/paper.md`) trained a multilayer perceptron mapping the finger's
 //! position and contact force to the maximum principal stress of 377 liver elements, and scored
 //! it with the Fit of its eq. 5 (92.64 % on three unseen locations). This crate provides:
 //!
