@@ -409,7 +409,7 @@ fn raster_locations(r: &RasterSpec) -> Result<(Split, Vec<CampaignLocation>), St
 /// ROI the paper's 377 elements. At 5 mm the ROI stress is not converged in the mesh: the 5 mm
 /// field predicts the 3 mm field at the same location with a Fit of -0.20 to 0.73, its peaks
 /// 1.0-3.1 times the 3 mm ones. The held-out GP Fit of the paper's protocol is 0.897 at 3 mm
-/// against 0.867 at 5 mm (README, surrogate section). A run takes 17-23 min on one thread
+/// against 0.867 at 5 mm (docs/campaigns.md). A run takes 17-23 min on one thread
 /// against 2-3 min at 5 mm.
 pub const CAMPAIGN_VOXEL: f64 = PAPER_VOXEL;
 

@@ -71,7 +71,7 @@ impl Default for RoiParams {
 /// along x from -100 to 0 mm and 15 mm apart along y from 225 to 165 mm. An earlier default
 /// spaced the rows 25 mm apart too (y = 145..245 mm); its first and last rows lay 17-18 mm beyond
 /// the ROI, where the ROI's stress is weak, and the held-out GP Fit of the 5 mm campaign was
-/// 0.832 against 0.867 on this raster (same runs otherwise; README, surrogate section).
+/// 0.832 against 0.867 on this raster (same runs otherwise; docs/campaigns.md).
 #[derive(Clone, Debug, PartialEq)]
 pub struct GridParams {
     /// Raster centre (x, y) (m).

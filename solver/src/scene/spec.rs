@@ -1,6 +1,6 @@
 //! The scene file format (TOML). Every physical quantity takes a unit (`"40 kPa"`, `"25 ms"`);
 //! plain numbers are SI. Unknown keys are errors. See `scenes/*.toml` for commented examples
-//! and the README for the full tour.
+//! and docs/scenes.md for the full tour.
 
 use material::quantity::{Acceleration, Force, Length, Number, Rate, Time, Velocity};
 use material::MaterialSpec;

@@ -26,7 +26,7 @@
 //! [`GpOptions::output_tolerance`], and the basis is kept only when it costs less than `A`.
 //! On the default 3 mm campaign's 6 x 377 tensor components (150 rows), a tolerance of 1e-4
 //! keeps about 35 directions and cuts the mean's cost about 4 times; the held-out Fit moves by
-//! less than 1e-3 (README). The variance does not use `A` and is exact.
+//! less than 1e-3 (docs/surrogate.md). The variance does not use `A` and is exact.
 
 use super::kernel::SeArd;
 use super::likelihood::{compute_factorised, compute_nll_and_gradient, PairwiseSquares};
