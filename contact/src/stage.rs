@@ -736,11 +736,6 @@ impl ContactStage {
         &self.states
     }
 
-    /// The run-time indenters (geometry and direction).
-    pub fn indenter_geometry(&self) -> &[Indenter] {
-        &self.indenters
-    }
-
     /// Contact energy `Pi + D` (J): stored penalty energy plus the energy dissipated by contact
     /// damping and friction; the term that closes the body's energy balance.
     pub fn energy(&self) -> f64 {

@@ -62,6 +62,19 @@ pub fn fields(
             cols.push(None);
         }
     } else {
+        if !text.is_ascii() {
+            // Fixed columns count characters as LS-DYNA does (bytes of an ASCII deck): a
+            // non-ASCII character would shift every later field.
+            let col = text
+                .char_indices()
+                .find(|(_, c)| !c.is_ascii())
+                .map_or(0, |(i, _)| i)
+                + 1;
+            return Err(format!(
+                "{}: *{}: a character that is not ASCII in column {col} of a fixed-format card; LS-DYNA reads such cards column by column, so write the line in ASCII (or comma-separated)",
+                card.at, block.name
+            ));
+        }
         let mut start = 0;
         for &(_, w) in layout {
             let w = block.format.width(w);
@@ -271,6 +284,24 @@ mod tests {
     }
 
     const L: &[Field] = &[("MID", 10), ("RO", 10), ("E", 10), ("PR", 10)];
+
+    #[test]
+    fn non_ascii_in_a_fixed_format_card_is_an_error_not_a_panic() {
+        // U+FFFD is what a Latin-1 byte becomes when the deck is read; it sits across the
+        // boundary of the second field.
+        let b = block(
+            Format::Standard,
+            "         1  1.0e-6\u{fffd}  2.0e-3       0.3",
+        );
+        let e = fields(&b, Some(&b.cards[0]), L).unwrap_err();
+        assert!(
+            e.contains("d.k:3") && e.contains("not ASCII in column 19"),
+            "{e}"
+        );
+        // Free format is cut at commas, where any text is fine.
+        let b = block(Format::Standard, "1,1e-6,2e-3,0.3");
+        assert!(fields(&b, Some(&b.cards[0]), L).is_ok());
+    }
 
     #[test]
     fn fixed_free_and_long_formats() {

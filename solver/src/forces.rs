@@ -56,7 +56,8 @@ pub struct ElementTotals {
     pub first_eroded: Option<u32>,
 }
 
-/// A raw pointer shared by the element loop to write disjoint per-element ranges.
+/// A raw pointer shared by the element loop to write disjoint ranges: history and stress per
+/// element, chunk results per chunk, nodal forces per node of a colour's chunks.
 #[derive(Clone, Copy)]
 struct Shared<T>(*mut T);
 unsafe impl<T> Send for Shared<T> {}
@@ -121,6 +122,24 @@ pub fn element_loop(
     force: &mut [[f64; 3]],
     stress: Option<&mut [[f64; 6]]>,
 ) -> Result<ElementTotals, (u32, String)> {
+    // The kernels index these arrays by the connectivity without bounds checks (the model
+    // checked every element's nodes against its mesh when it was built).
+    let n_nodes = x_ref.len();
+    assert!(
+        u.len() == n_nodes && v.len() == n_nodes && force.len() == n_nodes,
+        "element_loop: u, v and force need one entry per node of x_ref"
+    );
+    assert!(
+        groups.iter().all(|g| g.max_node() < n_nodes),
+        "element_loop: an element refers to a node beyond x_ref"
+    );
+    if let Some(s) = &stress {
+        let ne = groups.iter().flat_map(|g| g.elements.iter()).max();
+        assert!(
+            ne.is_none_or(|&e| (e as usize) < s.len()),
+            "element_loop: stress is too short"
+        );
+    }
     let stress_ptr = stress.map(|s| Shared(s.as_mut_ptr()));
     force.par_chunks_mut(4096).for_each(|c| c.fill([0.0; 3]));
     let force_ptr = Shared(force.as_mut_ptr());
@@ -354,8 +373,8 @@ impl GatherLanes for ScalarGather {
     }
 }
 
-/// AVX-512 gather instructions, one per component and node (used only inside
-/// [`run_chunk_avx512`]).
+/// AVX-512 masked loads and permutes ([`gather_avx512`]). Sound only inside
+/// [`run_chunk_avx512`], which is entered only on a processor with AVX-512.
 struct Avx512Gather;
 
 impl GatherLanes for Avx512Gather {
@@ -414,6 +433,5 @@ unsafe fn gather_avx512(field: &[[f64; 3]], conn: &[[u32; 8]; LANES]) -> Nodal<F
         out[1][a] = lanes(_mm512_permutex2var_pd(t0, i_hi, t2));
         out[2][a] = lanes(_mm512_permutex2var_pd(t1, i_lo, t3));
     }
-    let _ = n;
     out
 }

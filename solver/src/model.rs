@@ -162,7 +162,7 @@ pub struct Group {
     /// a node, so the chunks of a colour add their element forces straight into the nodal
     /// force array in parallel without a race, and every node receives its contributions in
     /// the same order (colour, then element order within its chunk) on any thread count.
-    pub colours: Vec<Vec<u32>>,
+    pub(crate) colours: Vec<Vec<u32>>,
     /// Scratch: per-chunk partial results.
     pub chunks: Vec<ChunkOut>,
     /// Eroded flags (empty unless the law can fail).
@@ -183,6 +183,17 @@ pub struct Group {
 pub const CHUNK: usize = 512;
 
 impl Group {
+    /// Largest node index of the group's elements (0 for an empty group).
+    pub fn max_node(&self) -> usize {
+        self.conn.iter().flatten().copied().max().unwrap_or(0) as usize
+    }
+
+    /// The element loop's colouring (see [`Group::colours`]): the number of colours and the
+    /// fewest chunks any colour has (the parallelism the element loop can use).
+    pub fn colouring(&self) -> (usize, usize) {
+        let fewest = self.colours.iter().map(|c| c.len()).min().unwrap_or(0);
+        (self.colours.len(), fewest)
+    }
     /// Number of batches of [`LANES`] elements (the last one padded with copies of the group's
     /// last element, whose results are discarded).
     pub fn batches(&self) -> usize {
@@ -208,7 +219,7 @@ impl Group {
 /// of one colour share a node: greedy, each chunk taking the lowest colour none of the earlier
 /// chunks it shares a node with has. A mesh numbered for locality (slabs of elements) needs a few
 /// colours; each colour lists its chunks in ascending order.
-fn colour_chunks(conn: &[[u32; 8]], n_nodes: usize) -> Vec<Vec<u32>> {
+pub(crate) fn colour_chunks(conn: &[[u32; 8]], n_nodes: usize) -> Vec<Vec<u32>> {
     let n_chunks = conn.len().div_ceil(CHUNK);
     // For each node, the chunks (ascending) that touch it.
     let mut node_chunks: Vec<Vec<u32>> = vec![Vec::new(); n_nodes];
@@ -668,5 +679,87 @@ impl Model {
     /// Total added mass (kg).
     pub fn added_mass(&self) -> f64 {
         self.part_mass.iter().map(|p| p.added).sum()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Connectivity of an nx x ny x nz block of hexahedra, elements in x-fastest order.
+    fn block(nx: u32, ny: u32, nz: u32) -> (Vec<[u32; 8]>, usize) {
+        let id = |i: u32, j: u32, k: u32| (k * (ny + 1) + j) * (nx + 1) + i;
+        let mut conn = Vec::new();
+        for k in 0..nz {
+            for j in 0..ny {
+                for i in 0..nx {
+                    conn.push([
+                        id(i, j, k),
+                        id(i + 1, j, k),
+                        id(i + 1, j + 1, k),
+                        id(i, j + 1, k),
+                        id(i, j, k + 1),
+                        id(i + 1, j, k + 1),
+                        id(i + 1, j + 1, k + 1),
+                        id(i, j + 1, k + 1),
+                    ]);
+                }
+            }
+        }
+        (conn, ((nx + 1) * (ny + 1) * (nz + 1)) as usize)
+    }
+
+    /// Every chunk in exactly one colour, and no two chunks of a colour sharing a node.
+    fn assert_valid(conn: &[[u32; 8]], n_nodes: usize, colours: &[Vec<u32>]) {
+        let n_chunks = conn.len().div_ceil(CHUNK);
+        let mut seen = vec![0; n_chunks];
+        for colour in colours {
+            let mut owner = vec![u32::MAX; n_nodes];
+            for &ci in colour {
+                seen[ci as usize] += 1;
+                let c = ci as usize;
+                for e in &conn[c * CHUNK..((c + 1) * CHUNK).min(conn.len())] {
+                    for &n in e {
+                        let o = &mut owner[n as usize];
+                        assert!(
+                            *o == u32::MAX || *o == ci,
+                            "chunks {} and {ci} share node {n}",
+                            *o
+                        );
+                        *o = ci;
+                    }
+                }
+            }
+            assert!(
+                colour.windows(2).all(|w| w[0] < w[1]),
+                "chunks in ascending order"
+            );
+        }
+        assert!(seen.iter().all(|&s| s == 1), "every chunk coloured once");
+    }
+
+    #[test]
+    fn colouring_of_an_ordered_block_is_race_free_and_parallel() {
+        let (conn, nn) = block(50, 50, 40);
+        let colours = colour_chunks(&conn, nn);
+        assert_valid(&conn, nn, &colours);
+        // Slabs of 512 elements in a 50 x 50 plane: a handful of colours, each with many chunks.
+        assert!(colours.len() <= 6, "{} colours", colours.len());
+        assert!(colours.iter().all(|c| c.len() >= 20));
+    }
+
+    #[test]
+    fn colouring_of_a_shuffled_block_is_still_race_free() {
+        let (mut conn, nn) = block(20, 20, 20);
+        // A fixed pseudo-random permutation of the elements (xorshift).
+        let mut s = 0x9e37_79b9_7f4a_7c15u64;
+        for i in (1..conn.len()).rev() {
+            s ^= s << 13;
+            s ^= s >> 7;
+            s ^= s << 17;
+            conn.swap(i, (s % (i as u64 + 1)) as usize);
+        }
+        let colours = colour_chunks(&conn, nn);
+        assert_valid(&conn, nn, &colours);
     }
 }

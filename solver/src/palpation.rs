@@ -17,7 +17,7 @@
 use crate::element::{HourglassForm, HourglassModulus};
 use crate::model::StepTarget;
 use crate::output::history::{column, read_history};
-use crate::phantom::{DEFAULT_VOXEL, PAPER_VOXEL};
+use crate::phantom::DEFAULT_VOXEL;
 use std::fmt::Write;
 use std::path::Path;
 
@@ -213,14 +213,6 @@ fn scaled_liver_card(s: f64) -> String {
 }
 
 impl PalpationSetup {
-    /// The paper's protocol at the paper-like resolution (3 mm voxels, about 105k hexahedra).
-    pub fn paper_resolution() -> Self {
-        PalpationSetup {
-            voxel: PAPER_VOXEL,
-            ..Default::default()
-        }
-    }
-
     /// Check the values a user can set.
     pub fn validate(&self) -> Result<(), String> {
         let pos = |v: f64, what: &str| {

@@ -1,5 +1,5 @@
 //! The same scene gives bitwise identical results on 1 and 2 threads (issue 2): element forces
-//! are gathered per node in a fixed order and chunk partial sums are reduced in chunk order;
+//! are added into each node in a fixed order (colour, then element order) and chunk partial sums are reduced in chunk order;
 //! run-time mass scaling adds its mass serially in element order.
 
 mod common;

@@ -346,3 +346,36 @@ fn palpa_frames_keep_part_names_and_draw_indenters() {
         "{e}"
     );
 }
+
+/// Read a legacy .vtk written from `text` (a temporary file); the error or the mesh.
+fn read_legacy_text(text: &str) -> Result<solver::mesh_io::Imported, String> {
+    let dir = tempfile::tempdir().unwrap();
+    let p = dir.path().join("bad.vtk");
+    std::fs::write(&p, text).unwrap();
+    read_mesh(&p, 1.0)
+}
+
+const LEGACY_HEAD: &str = "# vtk DataFile Version 3.0\nbad\nASCII\nDATASET UNSTRUCTURED_GRID\n";
+
+#[test]
+fn legacy_vtk_with_a_huge_point_count_is_an_error_not_an_abort() {
+    for n in ["10000000000000000000", "6148914691236517206", "4294967297"] {
+        let e = read_legacy_text(&format!("{LEGACY_HEAD}POINTS {n} float\n0 0 0\n"))
+            .err()
+            .expect("an error");
+        assert!(e.contains("bad.vtk"), "{e}");
+    }
+}
+
+#[test]
+fn legacy_vtk_cell_with_a_negative_or_fractional_node_is_refused() {
+    let pts = "POINTS 8 float\n0 0 0 1 0 0 1 1 0 0 1 0 0 0 1 1 0 1 1 1 1 0 1 1\n";
+    for conn in ["8 -1 1 2 3 4 5 6 7", "8 0 1 2 3.5 4 5 6 7"] {
+        let text = format!("{LEGACY_HEAD}{pts}CELLS 1 9\n{conn}\nCELL_TYPES 1\n12\n");
+        let e = read_legacy_text(&text).err().expect("an error");
+        assert!(e.contains("not a whole non-negative number"), "{e}");
+    }
+    // The same cell with valid ids reads.
+    let text = format!("{LEGACY_HEAD}{pts}CELLS 1 9\n8 0 1 2 3 4 5 6 7\nCELL_TYPES 1\n12\n");
+    assert_eq!(read_legacy_text(&text).unwrap().mesh.elements.len(), 1);
+}

@@ -4,7 +4,7 @@
 //! stepped `--steps` times after its first force evaluation, inside a rayon pool of each
 //! requested thread count. Reported per case and thread count:
 //! - element-cycles per second = elements x steps / wall time of the stepping loop;
-//! - the share of step time of every active stage (elements, gather, update, contact, ...);
+//! - the share of step time of every active stage (element forces, update, contact, ...);
 //! - the speed-up of N threads over 1 thread, both measured in the same invocation.
 //!
 //! Cases (issue 2 and issue 4 of the tracker):

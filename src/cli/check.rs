@@ -103,6 +103,14 @@ pub fn check(path: &Path, deck: &DeckArgs) -> Result<(), String> {
         bytes as f64 / 1048576.0,
         hist as f64 * 8.0 / 1048576.0
     );
+    for g in &m.groups {
+        let (colours, fewest) = g.colouring();
+        println!(
+            "  element loop, part {}: {} chunks in {colours} colours (fewest {fewest} chunks per colour: the parallelism of its slowest pass)",
+            m.parts[g.part].name,
+            g.elements.len().div_ceil(solver::model::CHUNK),
+        );
+    }
     println!("  stages: {}", sim.active_stages().join(", "));
     Ok(())
 }

@@ -299,13 +299,7 @@ fn write_nifti_atomic(vol: &LabelVolume, path: &Path) -> Result<(), String> {
         "nii"
     };
     let tmp = path.with_file_name(format!(".{name}.{}.tmp.{ext}", std::process::id()));
-    let res = voxel::write_nifti(vol, &tmp).and_then(|_| {
-        std::fs::rename(&tmp, path).map_err(|e| format!("{}: cannot write: {e}", path.display()))
-    });
-    if res.is_err() {
-        let _ = std::fs::remove_file(&tmp);
-    }
-    res
+    solver::output::atomic::write_atomic_with(path, &tmp, |tmp| voxel::write_nifti(vol, tmp))
 }
 
 fn write_mesh(mesh: &Mesh, path: &Path, title: &str) -> Result<(), String> {

@@ -19,7 +19,7 @@
 //! half-written dataset.
 
 use crate::error::{Error, Result};
-use ndarray::{Array1, Array2, Array3, ArrayBase, Axis, DataOwned, Dimension};
+use ndarray::{Array1, Array2, Array3, ArrayBase, DataOwned, Dimension};
 use ndarray_npy::{NpzReader, NpzWriter, ReadableElement};
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
@@ -132,20 +132,6 @@ impl Dataset {
         (0..self.n_samples())
             .filter(|&i| self.split[i] == split)
             .collect()
-    }
-
-    /// The samples at `rows`, as a dataset with the same ROI and manifest.
-    pub fn select_rows(&self, rows: &[usize]) -> Dataset {
-        Dataset {
-            x: self.x.select(Axis(0), rows),
-            y: self.y.select(Axis(0), rows),
-            stress: self.stress.as_ref().map(|s| s.select(Axis(0), rows)),
-            roi_ids: self.roi_ids.clone(),
-            roi_centroids: self.roi_centroids.clone(),
-            location: self.location.select(Axis(0), rows),
-            split: self.split.select(Axis(0), rows),
-            manifest: self.manifest.clone(),
-        }
     }
 
     /// Label of location `id`: the manifest's label, or `loc-ID` when it has none.

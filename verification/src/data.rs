@@ -62,16 +62,6 @@ pub fn s<'a>(v: &'a Value, path: &str) -> &'a str {
         .unwrap_or_else(|| panic!("`{path}` is not a string"))
 }
 
-/// An array of numbers.
-pub fn vec_f(v: &Value, path: &str) -> Vec<f64> {
-    at(v, path)
-        .as_array()
-        .unwrap_or_else(|| panic!("`{path}` is not an array"))
-        .iter()
-        .map(|x| x.as_f64().unwrap())
-        .collect()
-}
-
 /// An array of node ids.
 pub fn vec_u32(v: &Value, path: &str) -> Vec<u32> {
     at(v, path)

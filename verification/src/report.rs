@@ -2,7 +2,6 @@
 
 use crate::CaseOutput;
 use std::fmt::Write as _;
-use std::path::Path;
 
 /// Outcome of one row.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -307,9 +306,4 @@ pub fn markdown(title: &str, out: &CaseOutput, plots: &[String], wall_seconds: f
     s
 }
 
-/// Write `text` to `path` atomically (temporary file, then rename).
-pub fn write_atomic(path: &Path, text: &[u8]) -> Result<(), String> {
-    let tmp = path.with_extension("tmp");
-    std::fs::write(&tmp, text).map_err(|e| format!("cannot write `{}`: {e}", tmp.display()))?;
-    std::fs::rename(&tmp, path).map_err(|e| format!("cannot write `{}`: {e}", path.display()))
-}
+pub use solver::output::atomic::write_atomic;

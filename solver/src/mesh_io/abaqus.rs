@@ -271,6 +271,12 @@ fn parse(lines: &[Line]) -> Result<RawMesh, String> {
                                 at(d.0)
                             ));
                         }
+                        if (b - a) / s >= 100_000_000 {
+                            return Err(format!(
+                                "{}: generate `{a}, {b}, {s}` lists more than 1e8 ids",
+                                at(d.0)
+                            ));
+                        }
                         ids.extend((a..=b).step_by(s as usize));
                     } else {
                         for tok in &d.1 {

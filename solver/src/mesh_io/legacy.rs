@@ -114,7 +114,7 @@ fn parse(c: &mut Cursor) -> Result<Parsed, String> {
             "POINTS" => {
                 let n = count(&w, 1, "POINTS n type")?;
                 let ty = w.get(2).ok_or("POINTS without a type")?;
-                let v = c.numbers(3 * n, ty)?;
+                let v = c.numbers(times(3, n)?, ty)?;
                 points = Some(v.chunks_exact(3).map(|p| [p[0], p[1], p[2]]).collect());
             }
             "CELLS" => {
@@ -152,6 +152,12 @@ fn parse(c: &mut Cursor) -> Result<Parsed, String> {
     Ok((points, types, cells, arrays, strings))
 }
 
+/// `a * b` for array sizes, an error instead of an overflow.
+fn times(a: usize, b: usize) -> Result<usize, String> {
+    a.checked_mul(b)
+        .ok_or_else(|| format!("an array of {a} x {b} values is larger than any file"))
+}
+
 fn count(w: &[String], k: usize, form: &str) -> Result<usize, String> {
     w.get(k)
         .and_then(|s| s.parse().ok())
@@ -179,26 +185,26 @@ fn read_cells(c: &mut Cursor, n: usize, size: usize) -> Result<Vec<Vec<u64>>, St
         }
         let ty = cw.next().ok_or("CONNECTIVITY without a type")?.to_string();
         let conn = c.numbers(size, &ty)?;
-        let mut out = Vec::with_capacity(n.saturating_sub(1));
+        let mut out = Vec::with_capacity(n.saturating_sub(1).min(conn.len()));
         for k in 1..n {
             let (a, b) = (off[k - 1] as usize, off[k] as usize);
             if a > b || b > conn.len() {
                 return Err("cell offsets out of order or past the connectivity".into());
             }
-            out.push(conn[a..b].iter().map(|&v| v as u64).collect());
+            out.push(node_ids(&conn[a..b])?);
         }
         return Ok(out);
     }
     (c.at, c.line) = save;
     let v = c.numbers(size, "int")?;
-    let mut out = Vec::with_capacity(n);
+    let mut out = Vec::with_capacity(n.min(v.len()));
     let mut i = 0;
     for _ in 0..n {
         let k = *v.get(i).ok_or("CELLS shorter than its size")? as usize;
         let s = v
             .get(i + 1..i + 1 + k)
             .ok_or("CELLS shorter than its size")?;
-        out.push(s.iter().map(|&x| x as u64).collect());
+        out.push(node_ids(s)?);
         i += k + 1;
     }
     Ok(out)
@@ -243,10 +249,13 @@ fn attributes(
             }
             "COLOR_SCALARS" => {
                 let m = count(&w, 2, "COLOR_SCALARS name n")?;
-                c.numbers(n * m, if c.binary { "unsigned_char" } else { "float" })?;
+                c.numbers(
+                    times(n, m)?,
+                    if c.binary { "unsigned_char" } else { "float" },
+                )?;
             }
             "VECTORS" | "NORMALS" => {
-                c.numbers(3 * n, w.get(2).ok_or("no type")?)?;
+                c.numbers(times(3, n)?, w.get(2).ok_or("no type")?)?;
             }
             "TENSORS" | "TENSORS6" => {
                 let k = if w[0].eq_ignore_ascii_case("TENSORS6") {
@@ -254,11 +263,11 @@ fn attributes(
                 } else {
                     9
                 };
-                c.numbers(k * n, w.get(2).ok_or("no type")?)?;
+                c.numbers(times(k, n)?, w.get(2).ok_or("no type")?)?;
             }
             "TEXTURE_COORDINATES" => {
                 let d = count(&w, 2, "TEXTURE_COORDINATES name dim type")?;
-                c.numbers(d * n, w.get(3).ok_or("no type")?)?;
+                c.numbers(times(d, n)?, w.get(3).ok_or("no type")?)?;
             }
             "FIELD" => {
                 let k = count(&w, 2, "FIELD name n")?;
@@ -377,7 +386,7 @@ impl<'a> Cursor<'a> {
             let len = n.checked_mul(size).ok_or("array too large")?;
             let s = self
                 .b
-                .get(self.at..self.at + len)
+                .get(self.at..self.at.saturating_add(len))
                 .ok_or_else(|| format!("file ends inside a binary array of {n} `{ty}`"))?;
             let v = s.chunks_exact(size).map(|w| decode(w, kind)).collect();
             self.at += len;
@@ -388,7 +397,9 @@ impl<'a> Cursor<'a> {
             self.line += 1;
             Ok(v)
         } else {
-            let mut v = Vec::with_capacity(n);
+            // A count larger than the rest of the file is caught when the numbers run out; the
+            // capacity never exceeds what the file can hold.
+            let mut v = Vec::with_capacity(n.min(self.b.len().saturating_sub(self.at)));
             while v.len() < n {
                 self.skip_space();
                 if self.at >= self.b.len() {
@@ -428,7 +439,7 @@ impl<'a> Cursor<'a> {
     }
 
     fn strings(&mut self, n: usize) -> Result<Vec<String>, String> {
-        let mut out = Vec::with_capacity(n);
+        let mut out = Vec::with_capacity(n.min(self.b.len().saturating_sub(self.at)));
         if self.binary {
             for _ in 0..n {
                 let b0 = *self
@@ -503,6 +514,22 @@ fn decode(w: &[u8], kind: Kind) -> f64 {
     }
 }
 
+/// Node ids of one cell: whole, non-negative numbers (a negative or fractional id is an error,
+/// not a node the cast would invent).
+fn node_ids(v: &[f64]) -> Result<Vec<u64>, String> {
+    v.iter()
+        .map(|&x| {
+            if x >= 0.0 && x.fract() == 0.0 && x < u64::MAX as f64 {
+                Ok(x as u64)
+            } else {
+                Err(format!(
+                    "a cell lists the node id {x}, not a whole non-negative number"
+                ))
+            }
+        })
+        .collect()
+}
+
 /// VTK escapes characters in ASCII strings as `%XX`.
 fn unescape(s: &str) -> String {
     let b = s.as_bytes();
@@ -510,8 +537,9 @@ fn unescape(s: &str) -> String {
     let mut i = 0;
     while i < b.len() {
         if b[i] == b'%' && i + 2 < b.len() {
-            if let Ok(v) = u8::from_str_radix(&s[i + 1..i + 3], 16) {
-                out.push(v);
+            let hex = |c: u8| (c as char).to_digit(16);
+            if let (Some(h), Some(l)) = (hex(b[i + 1]), hex(b[i + 2])) {
+                out.push((h * 16 + l) as u8);
                 i += 3;
                 continue;
             }
@@ -520,4 +548,16 @@ fn unescape(s: &str) -> String {
         i += 1;
     }
     String::from_utf8_lossy(&out).into_owned()
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn unescape_decodes_hex_and_leaves_anything_else() {
+        assert_eq!(super::unescape("liver%20left"), "liver left");
+        assert_eq!(super::unescape("end%41"), "endA");
+        // A `%` before non-ASCII text or at the end is kept as it is (it used to panic).
+        assert_eq!(super::unescape("%a\u{e9}x"), "%a\u{e9}x");
+        assert_eq!(super::unescape("50%"), "50%");
+    }
 }

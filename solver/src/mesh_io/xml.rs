@@ -239,7 +239,9 @@ impl Encoding {
             } else {
                 block
             };
-            let mut part = Vec::with_capacity(size);
+            // The header's block size is only a hint for the capacity: the decompressor stops
+            // at the data's end, and a block that disagrees with it is reported below.
+            let mut part = Vec::with_capacity(size.min(1 << 24));
             match self.compressor.as_str() {
                 "vtkZLibDataCompressor" => {
                     flate2::read::ZlibDecoder::new(chunk)

@@ -11,13 +11,19 @@ pub fn von_mises(s: &[f64; 6]) -> f64 {
         .sqrt()
 }
 
-/// Principal stresses, largest first.
+/// Principal stresses, largest first; all NaN if the tensor has a NaN (the element loop stops a
+/// run before a non-finite stress reaches an output, so this only guards against a panic).
 pub fn principal(s: &[f64; 6]) -> [f64; 3] {
     let [xx, yy, zz, xy, yz, zx] = *s;
     let m = Matrix3::new(xx, xy, zx, xy, yy, yz, zx, yz, zz);
     let e = SymmetricEigen::new(m).eigenvalues;
     let mut v = [e[0], e[1], e[2]];
-    v.sort_by(|a, b| b.partial_cmp(a).unwrap());
+    if v.iter().any(|x| x.is_nan()) {
+        return [f64::NAN; 3];
+    }
+    // No NaN: partial_cmp is total here, and a stable sort keeps the solver's order of equal
+    // values (so -0 and 0 print as before).
+    v.sort_by(|a, b| b.partial_cmp(a).unwrap_or(std::cmp::Ordering::Equal));
     v
 }
 
@@ -33,5 +39,11 @@ mod tests {
         let shear = [0.0, 0.0, 0.0, 2.0, 0.0, 0.0];
         assert!((von_mises(&shear) - 2.0 * 3f64.sqrt()).abs() < 1e-12);
         assert!((principal(&shear)[0] - 2.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn principal_of_a_nan_tensor_is_nan_not_a_panic() {
+        let p = principal(&[1.0, f64::NAN, 0.0, 0.0, 0.0, 0.0]);
+        assert!(p.iter().all(|x| x.is_nan()));
     }
 }

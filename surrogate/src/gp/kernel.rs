@@ -44,14 +44,6 @@ impl SeArd {
         }
     }
 
-    /// The log-parameters `[ln l_1 .. ln l_D, ln s2, ln sn2]`.
-    pub fn log_params(&self) -> Vec<f64> {
-        let mut t: Vec<f64> = self.length_scales.iter().map(|l| l.ln()).collect();
-        t.push(self.signal_variance.ln());
-        t.push(self.noise_variance.ln());
-        t
-    }
-
     /// Correlation part `exp(-1/2 sum_d ((a_d - b_d)/l_d)^2)` for points already divided by the
     /// length scales (`a_s = a / l`), times the signal variance.
     #[inline]
