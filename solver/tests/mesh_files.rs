@@ -379,3 +379,29 @@ fn legacy_vtk_cell_with_a_negative_or_fractional_node_is_refused() {
     let text = format!("{LEGACY_HEAD}{pts}CELLS 1 9\n8 0 1 2 3 4 5 6 7\nCELL_TYPES 1\n12\n");
     assert_eq!(read_legacy_text(&text).unwrap().mesh.elements.len(), 1);
 }
+
+#[test]
+fn abaqus_reference_point_at_the_assembly_level_is_skipped_with_a_note() {
+    // Abaqus/CAE writes a reference point as an assembly-level *Node whose label (1) is also a
+    // node of the part.
+    let text = std::fs::read_to_string(file("abaqus.inp")).unwrap();
+    let text = text.replacen(
+        "*End Assembly",
+        "*Node\n      1,           0.,           0.,          50.\n*Nset, nset=RP-1\n 1,\n*End Assembly",
+        1,
+    );
+    assert!(text.contains("RP-1"));
+    let dir = tempfile::tempdir().unwrap();
+    let p = dir.path().join("cae.inp");
+    std::fs::write(&p, text).unwrap();
+    let m = read_mesh(&p, 1e-3).unwrap_or_else(|e| panic!("{e}"));
+    check_block(&m.mesh, ["FAT", "MUSCLE"]);
+    assert!(!m.mesh.node_sets.contains_key("RP-1"));
+    assert!(
+        m.notes
+            .iter()
+            .any(|n| n.contains("1 node(s) at the assembly level") && n.contains("RP-1")),
+        "{:?}",
+        m.notes
+    );
+}

@@ -1,5 +1,7 @@
 //! Abaqus input files (`.inp`): the mesh part of a flat input file or of one `*Part` (with at
-//! most one `*Instance` of it, without translation or rotation).
+//! most one `*Instance` of it, without translation or rotation). Nodes that Abaqus/CAE writes at
+//! the assembly level (reference points, outside any `*Instance`) and node sets over them are
+//! skipped with a note: their labels restart at 1 and would collide with the part's.
 //!
 //! Hand-written: no maintained Rust crate reads Abaqus input. The syntax (Abaqus Keywords
 //! Reference): keyword lines `*Keyword, param=value, flag` (case-insensitive), data lines of
@@ -98,6 +100,12 @@ fn parse(lines: &[Line]) -> Result<RawMesh, String> {
     let mut sections: Vec<(String, String)> = Vec::new(); // (elset, where)
     let mut parts_seen = 0;
     let mut instances = 0;
+    // Inside *Assembly ... *End Assembly, and inside *Instance ... *End Instance.
+    let (mut in_assembly, mut in_instance) = (false, false);
+    let mut skipped_nodes = 0usize;
+    let mut skipped_sets: Vec<String> = Vec::new();
+    // Where each node set was (first) defined, for messages.
+    let mut nset_at: BTreeMap<String, String> = BTreeMap::new();
     let mut i = 0;
     while i < lines.len() {
         let l = &lines[i];
@@ -154,7 +162,17 @@ fn parse(lines: &[Line]) -> Result<RawMesh, String> {
                     ));
                 }
             }
+            "assembly" => in_assembly = true,
+            "end assembly" => in_assembly = false,
+            "end instance" => in_instance = false,
+            "node" if in_assembly && !in_instance => skipped_nodes += data.len(),
+            "nset" if in_assembly && !in_instance && !params.contains_key("instance") => {
+                if let Some(n) = params.get("nset") {
+                    skipped_sets.push(n.clone());
+                }
+            }
             "instance" => {
+                in_instance = true;
                 instances += 1;
                 if instances > 1 {
                     return Err(format!(
@@ -187,6 +205,7 @@ fn parse(lines: &[Line]) -> Result<RawMesh, String> {
                     raw.node_ids.push(id);
                 }
                 if let Some(s) = params.get("nset") {
+                    nset_at.entry(s.to_string()).or_insert_with(|| at(l));
                     let ids: Vec<i64> = data.iter().filter_map(|d| d.1[0].parse().ok()).collect();
                     nsets.entry(s.to_string()).or_default().extend(ids);
                 }
@@ -294,6 +313,7 @@ fn parse(lines: &[Line]) -> Result<RawMesh, String> {
                     }
                 }
                 let sets = if key == "nset" {
+                    nset_at.entry(set.clone()).or_insert_with(|| at(l));
                     &mut nsets
                 } else {
                     &mut elsets
@@ -309,6 +329,16 @@ fn parse(lines: &[Line]) -> Result<RawMesh, String> {
             _ => {}
         }
     }
+    if skipped_nodes > 0 {
+        raw.notes.push(format!(
+            "{skipped_nodes} node(s) at the assembly level (reference points) skipped{}",
+            if skipped_sets.is_empty() {
+                String::new()
+            } else {
+                format!(", with the node set(s) {}", skipped_sets.join(", "))
+            }
+        ));
+    }
     // Sets: labels -> indices; element sets keep hexahedra only.
     let find_set = |sets: &BTreeMap<String, Vec<i64>>, name: &str| {
         sets.iter()
@@ -319,7 +349,10 @@ fn parse(lines: &[Line]) -> Result<RawMesh, String> {
         let mut v = Vec::new();
         for id in ids {
             v.push(*node_index.get(id).ok_or_else(|| {
-                format!("node set `{name}` lists node {id}, which no *Node defines")
+                let at = nset_at
+                    .get(name)
+                    .map_or(String::new(), |w| format!("{w}: "));
+                format!("{at}node set `{name}` lists node {id}, which no *Node defines")
             })?);
         }
         raw.node_sets.insert(name.clone(), v);

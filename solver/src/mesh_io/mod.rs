@@ -58,6 +58,8 @@ pub struct RawMesh {
     pub node_sets: BTreeMap<String, Vec<u32>>,
     /// Named element sets (indices into `hexes`).
     pub element_sets: BTreeMap<String, Vec<u32>>,
+    /// What the reader skipped that the user should know (passed on to [`Imported::notes`]).
+    pub notes: Vec<String>,
 }
 
 /// A mesh read from a file, and what the reader did that the user should know.
@@ -150,7 +152,7 @@ pub fn finish(path: &Path, raw: RawMesh, scale: f64) -> Result<Imported, String>
         }
     }
     check_orientation(path, &raw)?;
-    let mut notes = Vec::new();
+    let mut notes = raw.notes.clone();
     // Keep only the nodes hexahedra use, in their file order.
     let mut used = vec![false; raw.nodes.len()];
     for c in &raw.hexes {
