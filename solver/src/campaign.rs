@@ -924,6 +924,15 @@ pub struct RunSamples {
 /// Read the samples of the finished run in `dir` (hand `hand`): `probe.csv`, `probe_stress.csv`
 /// and, for the filtered force, `history.csv`.
 pub fn read_run(dir: &Path) -> Result<RunSamples, String> {
+    read_run_files(dir).map_err(|e| {
+        format!(
+            "{e}; the run's files are damaged: remove {} and continue with --resume to redo the run",
+            dir.display()
+        )
+    })
+}
+
+fn read_run_files(dir: &Path) -> Result<RunSamples, String> {
     let hand = "hand";
     let p = read_probe(dir, hand)?;
     let (cols, rows) = read_history(&dir.join("probe.csv"))?;
