@@ -597,7 +597,7 @@ impl CampaignSpec {
                 for tf in &timing {
                     let duration = tf(depth);
                     let samples = duration / base.sample_interval + 1.0;
-                    if !(samples <= max_samples) {
+                    if samples.is_nan() || samples > max_samples {
                         return Err(format!(
                             "indentation.sample_interval: {:e} s over a duration of {:e} s gives {samples:.3e} samples a run, more than the limit of {max_samples:.0}; use a longer interval, or raise `indentation.max_samples` if you mean it",
                             base.sample_interval, duration

@@ -219,7 +219,7 @@ pub fn assemble(def: SceneDef) -> Result<Scene, String> {
         .map_err(|m| format!("{}: {m}", path.display()))?;
     let max_steps = setup.max_steps.unwrap_or(DEFAULT_MAX_STEPS);
     let steps = estimated_steps(&model, setup.dt_factor, setup.dt_max, end_time);
-    if !(steps <= max_steps) {
+    if steps.is_nan() || steps > max_steps {
         return Err(format!(
             "{}: the run would take about {steps:.3e} time steps (stable step {:.3e} s at element {}, end time {end_time:e} s), more than the limit of {max_steps:.0}; check the moduli and densities, or raise `[run] max_steps` if you mean it",
             path.display(),
