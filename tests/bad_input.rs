@@ -185,3 +185,107 @@ fn inverted_element_is_named() {
         "{err}"
     );
 }
+
+// Issue 29: values the mutation probe found accepted, aborting or hanging.
+
+#[test]
+fn infinite_end_time() {
+    bad(
+        "end_time_inf",
+        &GOOD.replace("end_time = \"1 ms\"", "end_time = inf"),
+        &["run.end_time", "finite", "end_time_inf.toml:3"],
+    );
+}
+
+#[test]
+fn negative_history_interval() {
+    bad(
+        "negative_history",
+        &format!("{GOOD}[output]\nhistory_interval = \"-1 ms\"\n"),
+        &["output.history_interval", "positive"],
+    );
+}
+
+#[test]
+fn negative_bulk_viscosity() {
+    bad(
+        "negative_bulk",
+        &format!("{GOOD}[bulk_viscosity]\nquadratic = -1\n"),
+        &["bulk_viscosity.quadratic", "got -1"],
+    );
+}
+
+#[test]
+fn absurd_divisions_refused_before_allocating() {
+    bad(
+        "divisions_u32",
+        &GOOD.replace("[2, 2, 2]", "[4294967297, 1, 1]"),
+        &["mesh.divisions", "4.2950e9 elements", "max_elements"],
+    );
+    bad(
+        "divisions_1e9",
+        &GOOD.replace("[2, 2, 2]", "[1000000000, 6, 6]"),
+        &["mesh.divisions", "3.6000e10 elements", "limit of 50000000"],
+    );
+    // Raising the limit is possible (and then the node ids are the limit).
+    bad(
+        "divisions_raised",
+        &GOOD.replace("[2, 2, 2]", "[4294967297, 1, 1]\nmax_elements = 1e12"),
+        &["more than node ids can number"],
+    );
+}
+
+#[test]
+fn non_physical_moduli_and_densities() {
+    // A huge stable step (0 estimated steps, then a run that never returned) ...
+    bad(
+        "tiny_modulus",
+        &GOOD.replace("\"1 MPa\"", "\"1e-320 Pa\""),
+        &["part `block`", "wave speed", "not physical"],
+    );
+    bad(
+        "huge_density",
+        &GOOD.replace("\"1000 kg/m^3\"", "\"1e308 kg/m^3\""),
+        &["part `block`", "density 1e308"],
+    );
+    // ... and a tiny one (1.7e152 estimated steps).
+    bad(
+        "tiny_density",
+        &GOOD.replace("\"1000 kg/m^3\"", "\"1e-300 kg/m^3\""),
+        &["part `block`", "density 1e-300", "wave speed"],
+    );
+}
+
+#[test]
+fn too_many_steps_refused_unless_raised() {
+    // 1e6 s of a 5 mm rubber block: about 8e9 steps.
+    let long = GOOD.replace("end_time = \"1 ms\"", "end_time = \"1e6 s\"")
+        + "[output]\nvtk = false\nhistory_interval = \"10 s\"\n";
+    bad("too_many_steps", &long, &["time steps", "max_steps"]);
+    let tmp = dir("raised_steps");
+    let p = tmp.path().join("raised.toml");
+    std::fs::write(
+        &p,
+        long.replace(
+            "end_time = \"1e6 s\"",
+            "end_time = \"1e6 s\"\nmax_steps = 1e11",
+        ),
+    )
+    .unwrap();
+    let (ok, err) = check(&p);
+    assert!(ok, "{err}");
+}
+
+#[test]
+fn tiny_output_intervals() {
+    bad(
+        "tiny_frames",
+        &format!("{GOOD}[output]\ninterval = \"1e-9 ms\"\n"),
+        &["output.interval", "1.000e9 frames", "max_outputs"],
+    );
+    bad(
+        "tiny_history",
+        &format!("{GOOD}[output]\nhistory_interval = \"1e-320 s\"\n"),
+        &["output.history_interval", "history rows", "max_outputs"],
+    );
+}

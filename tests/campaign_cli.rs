@@ -400,3 +400,43 @@ fn shipped_profiles_resolve_and_bad_keys_are_named() {
     let o = palpa(&["campaign", "--shard", "2/2", "--dry-run"]);
     assert!(!o.status.success());
 }
+
+/// Issue 29: `sample_interval = "1e-320 s"` was accepted and the campaign never ended; a run
+/// with more samples than the limit is refused, naming the key, unless the limit is raised.
+#[test]
+fn tiny_sample_interval_refused() {
+    let tmp = tempfile::tempdir().unwrap();
+    let p = tmp.path().join("tiny-interval.toml");
+    for (interval, expect) in [
+        ("1e-320 s", "more than the limit of 1000000"),
+        ("-1 ms", "must be a positive finite time"),
+    ] {
+        std::fs::write(
+            &p,
+            TINY.replace(
+                "sample_interval = \"0.5 ms\"",
+                &format!("sample_interval = \"{interval}\""),
+            ),
+        )
+        .unwrap();
+        let o = palpa(&["campaign", s(&p), "--dry-run"]);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(
+            !o.status.success()
+                && err.contains("tiny-interval.toml")
+                && err.contains("indentation.sample_interval")
+                && err.contains(expect),
+            "{interval}: {err}"
+        );
+    }
+    // 1 ns over 1 ms is 1e6 + 1 samples: refused by default, accepted when raised.
+    let text = TINY.replace("sample_interval = \"0.5 ms\"", "sample_interval = \"1 ns\"");
+    std::fs::write(&p, &text).unwrap();
+    assert!(!palpa(&["campaign", s(&p), "--dry-run"]).status.success());
+    std::fs::write(
+        &p,
+        text.replace("[indentation]", "[indentation]\nmax_samples = 2e6"),
+    )
+    .unwrap();
+    ok(&["campaign", s(&p), "--dry-run"]);
+}

@@ -275,3 +275,52 @@ fn mesh_import_reports_and_converts() {
         "{err}"
     );
 }
+
+/// Issue 29: a `.nii.gz` whose gzip checksum is wrong was meshed into different anatomy with
+/// exit 0, and a truncated one printed the reader's Rust error (`Io(Kind(UnexpectedEof))`);
+/// both are errors naming the file in words.
+#[test]
+fn corrupted_nii_gz_is_refused() {
+    let tmp = dir("nifti-bad");
+    let d = tmp.path();
+    let nii = d.join("x.nii.gz");
+    let map = d.join("map.toml");
+    std::fs::write(&map, "1 = \"flesh\"\n2 = \"liver\"\n").unwrap();
+    ok(&[
+        "mesh",
+        "phantom",
+        "--voxel",
+        "8mm",
+        "--out",
+        nii.to_str().unwrap(),
+    ]);
+    let bytes = std::fs::read(&nii).unwrap();
+    let bad = d.join("bad.nii.gz");
+    let image = |label: &str| {
+        let out = palpa(&[
+            "mesh",
+            "image",
+            bad.to_str().unwrap(),
+            "--labels",
+            map.to_str().unwrap(),
+            "--out",
+            d.join("y.vtu").to_str().unwrap(),
+        ]);
+        let err = String::from_utf8_lossy(&out.stderr).into_owned();
+        assert!(!out.status.success(), "{label}: accepted");
+        assert!(
+            err.contains("bad.nii.gz") && err.contains("gzip stream is damaged"),
+            "{label}: {err}"
+        );
+        assert!(!err.contains("Kind("), "{label}: {err}");
+    };
+    // The CRC-32 of the trailer, one bit flipped.
+    let mut crc = bytes.clone();
+    let n = crc.len();
+    crc[n - 8] ^= 1;
+    std::fs::write(&bad, &crc).unwrap();
+    image("checksum");
+    // Cut in the middle of the stream.
+    std::fs::write(&bad, &bytes[..bytes.len() / 2]).unwrap();
+    image("truncated");
+}

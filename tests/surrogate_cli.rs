@@ -240,3 +240,38 @@ fn bad_input_names_the_file_or_flag() {
     assert!(!o.status.success());
     assert!(err.contains("model.json"), "{err}");
 }
+
+/// Issue 29: one line of invalid UTF-8 ended `predict --stdin` and lost every later line; it
+/// gets an error reply naming its line and the stream goes on.
+#[test]
+fn predict_stdin_survives_invalid_utf8() {
+    let model = Path::new(env!("CARGO_MANIFEST_DIR")).join("data/default-model-gp");
+    let mut child = Command::new(env!("CARGO_BIN_EXE_palpa"))
+        .args(["predict", model.to_str().unwrap(), "--stdin"])
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    let good = b"{\"x\": 0.0, \"y\": 0.1, \"force\": 10.0}\n";
+    let mut input = Vec::new();
+    input.extend_from_slice(good);
+    input.extend_from_slice(b"{\"x\": \xff\xfe 0.0}\n");
+    input.extend_from_slice(good);
+    child.stdin.take().unwrap().write_all(&input).unwrap();
+    let out = child.wait_with_output().unwrap();
+    let err = text(&out.stderr);
+    assert!(out.status.success() && !err.contains("panicked"), "{err}");
+    let replies: Vec<serde_json::Value> = text(&out.stdout)
+        .lines()
+        .map(|l| serde_json::from_str(l).unwrap())
+        .collect();
+    assert_eq!(replies.len(), 3, "{replies:?}");
+    assert_eq!(replies[1]["line"], 2);
+    let e = replies[1]["error"].as_str().unwrap();
+    assert!(e.contains("line 2") && e.contains("UTF-8"), "{e}");
+    assert_eq!(replies[2]["line"], 3);
+    assert!(replies[2]["stress"]
+        .as_array()
+        .is_some_and(|s| !s.is_empty()));
+}

@@ -1166,6 +1166,7 @@ fn build(cx: &mut Ctx, path: &Path) -> Result<SceneDef, Vec<String>> {
             dt_factor,
             dt_max,
             dt_min,
+            max_steps: None,
             hourglass_guard,
             bulk,
             damping,

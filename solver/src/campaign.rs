@@ -202,7 +202,13 @@ pub struct IndentationSpec {
     pub speed: Option<OneOrMany<Velocity>>,
     /// Interval between samples (default 5 ms).
     pub sample_interval: Option<Time>,
+    /// The most samples a run may record (default [`DEFAULT_MAX_SAMPLES`]); a shorter
+    /// sample interval is refused.
+    pub max_samples: Option<f64>,
 }
+
+/// The most samples one run may record unless `[indentation] max_samples` raises the limit.
+pub const DEFAULT_MAX_SAMPLES: f64 = 1e6;
 
 /// `[hand]`.
 #[derive(Clone, Debug, Default, Deserialize)]
@@ -498,6 +504,18 @@ impl CampaignSpec {
         let ind = &self.indentation;
         if let Some(t) = ind.sample_interval {
             base.sample_interval = t.0;
+            if !(t.0 > 0.0 && t.0.is_finite()) {
+                return Err(format!(
+                    "indentation.sample_interval must be a positive finite time, got {} s",
+                    t.0
+                ));
+            }
+        }
+        let max_samples = ind.max_samples.unwrap_or(DEFAULT_MAX_SAMPLES);
+        if !(max_samples >= 1.0 && max_samples.is_finite()) {
+            return Err(format!(
+                "indentation.max_samples must be a positive finite count, got {max_samples}"
+            ));
         }
         let depths: Vec<f64> = match &ind.depth {
             Some(d) => d.0.iter().map(|x| x.0).collect(),
@@ -578,6 +596,13 @@ impl CampaignSpec {
             for &depth in &depths {
                 for tf in &timing {
                     let duration = tf(depth);
+                    let samples = duration / base.sample_interval + 1.0;
+                    if samples.is_nan() || samples > max_samples {
+                        return Err(format!(
+                            "indentation.sample_interval: {:e} s over a duration of {:e} s gives {samples:.3e} samples a run, more than the limit of {max_samples:.0}; use a longer interval, or raise `indentation.max_samples` if you mean it",
+                            base.sample_interval, duration
+                        ));
+                    }
                     let label = if several {
                         format!(
                             "{}_d{}mm_t{}ms",
@@ -924,6 +949,15 @@ pub struct RunSamples {
 /// Read the samples of the finished run in `dir` (hand `hand`): `probe.csv`, `probe_stress.csv`
 /// and, for the filtered force, `history.csv`.
 pub fn read_run(dir: &Path) -> Result<RunSamples, String> {
+    read_run_files(dir).map_err(|e| {
+        format!(
+            "{e}; the run's files are damaged: remove {} and continue with --resume to redo the run",
+            dir.display()
+        )
+    })
+}
+
+fn read_run_files(dir: &Path) -> Result<RunSamples, String> {
     let hand = "hand";
     let p = read_probe(dir, hand)?;
     let (cols, rows) = read_history(&dir.join("probe.csv"))?;

@@ -72,11 +72,30 @@ impl SplitMix {
     }
 }
 
-/// Build the box mesh, with a single part named `part`.
+/// The most elements a scene's box may have unless its `[mesh] max_elements` raises the limit.
+pub const DEFAULT_MAX_ELEMENTS: f64 = 50e6;
+/// A rough memory cost of one hexahedron through a run (mesh, model, state and output), for the
+/// estimate in the message that refuses a box above the limit.
+pub const BYTES_PER_ELEMENT: f64 = 2048.0;
+
+/// Build the box mesh, with a single part named `part`. Node ids are `u32`: a box with more
+/// nodes than that is refused before anything is allocated.
 pub fn box_mesh(spec: &BoxSpec, part: &str) -> Result<Mesh, String> {
     let [nx, ny, nz] = spec.divisions;
     if nx == 0 || ny == 0 || nz == 0 {
         return Err("mesh divisions must be at least 1 along each axis".into());
+    }
+    let nodes = spec
+        .divisions
+        .iter()
+        .map(|&d| d as u128 + 1)
+        .product::<u128>();
+    if nodes > u32::MAX as u128 {
+        return Err(format!(
+            "mesh divisions {:?} give {nodes} nodes, more than node ids can number ({})",
+            spec.divisions,
+            u32::MAX
+        ));
     }
     for k in 0..3 {
         if !(spec.size[k] > 0.0) {

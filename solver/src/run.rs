@@ -273,6 +273,26 @@ fn probe_rows(scene: &Scene, p: &mut History, pt: &mut History, row: &mut Vec<f6
     pt.push(row);
 }
 
+/// The first output time after `t` on the grid `next + k dt` (k = 0, 1, ...), computed in one
+/// step rather than by adding `dt` until it passes `t`: a step far longer than the output
+/// interval (a huge stable step) would otherwise loop for as many intervals as the step spans,
+/// or for ever once `next + dt` rounds back to `next`. Never returns a time at or before `t`
+/// when `dt > 0`.
+pub fn next_output_time(next: f64, dt: f64, t: f64) -> f64 {
+    if dt.is_nan() || dt <= 0.0 || next > t {
+        return next;
+    }
+    let k = ((t - next) / dt).floor() + 1.0;
+    let n = next + k * dt;
+    if n > t {
+        n
+    } else if t + dt > t {
+        t + dt
+    } else {
+        t.next_up()
+    }
+}
+
 /// Run a scene, writing into `out`. `observer` is called every few steps and may update a
 /// progress bar. Returns the summary (also on failure, with the error in `status`) and the
 /// error if the run failed.
@@ -336,10 +356,7 @@ pub fn run_scene(
         if t >= next_hist || done {
             history_row(sim, &reactions, &mut row);
             history.push(&row);
-            next_hist += hist_dt;
-            while next_hist <= t && hist_dt > 0.0 {
-                next_hist += hist_dt;
-            }
+            next_hist = next_output_time(next_hist + hist_dt, hist_dt, t);
             if t > 0.01 * end {
                 max_err = max_err.max(sim.energy.error());
             }
@@ -369,10 +386,7 @@ pub fn run_scene(
                     break;
                 }
                 last_flush = Instant::now();
-                next_vtk += vdt;
-                while next_vtk <= t && vdt > 0.0 {
-                    next_vtk += vdt;
-                }
+                next_vtk = next_output_time(next_vtk + vdt, vdt, t);
             }
         }
         if done {

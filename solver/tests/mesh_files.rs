@@ -405,3 +405,75 @@ fn abaqus_reference_point_at_the_assembly_level_is_skipped_with_a_note() {
         m.notes
     );
 }
+
+/// Two unit-cell hexahedra side by side in an ASCII `.vtu`, with `parts` as the text of its
+/// `part_id` cell array.
+fn two_cells_vtu(parts: &str) -> String {
+    let mut pts = Vec::new();
+    for z in 0..2 {
+        for y in 0..2 {
+            for x in 0..3 {
+                pts.push(format!(
+                    "{} {} {}",
+                    x as f64 * 0.01,
+                    y as f64 * 0.01,
+                    z as f64 * 0.01
+                ));
+            }
+        }
+    }
+    let id = |x: usize, y: usize, z: usize| x + 3 * y + 6 * z;
+    let hex = |x0: usize| {
+        [
+            id(x0, 0, 0),
+            id(x0 + 1, 0, 0),
+            id(x0 + 1, 1, 0),
+            id(x0, 1, 0),
+            id(x0, 0, 1),
+            id(x0 + 1, 0, 1),
+            id(x0 + 1, 1, 1),
+            id(x0, 1, 1),
+        ]
+        .map(|n| n.to_string())
+        .join(" ")
+    };
+    format!(
+        r#"<?xml version="1.0"?>
+<VTKFile type="UnstructuredGrid" version="1.0" byte_order="LittleEndian">
+<UnstructuredGrid><Piece NumberOfPoints="12" NumberOfCells="2">
+<CellData><DataArray type="Int32" Name="part_id" format="ascii">{parts}</DataArray></CellData>
+<Points><DataArray type="Float64" NumberOfComponents="3" format="ascii">{}</DataArray></Points>
+<Cells><DataArray type="Int64" Name="connectivity" format="ascii">{} {}</DataArray>
+<DataArray type="Int64" Name="offsets" format="ascii">8 16</DataArray>
+<DataArray type="UInt8" Name="types" format="ascii">12 12</DataArray></Cells>
+</Piece></UnstructuredGrid></VTKFile>
+"#,
+        pts.join(" "),
+        hex(0),
+        hex(1)
+    )
+}
+
+/// Issue 29: a `part_id` array one entry short was silently dropped (one part "body"); it is
+/// an error naming the array and the cell count. A huge part id is only a key: the parts stay
+/// dense (no allocation by the id's size).
+#[test]
+fn vtu_part_id_array_one_short_is_an_error() {
+    let tmp = common::tmp_dir("vtu-parts");
+    let p = tmp.path().join("short.vtu");
+    for parts in ["1", ""] {
+        std::fs::write(&p, two_cells_vtu(parts)).unwrap();
+        let e = match read_mesh(&p, 1.0) {
+            Ok(_) => panic!("part_id `{parts}` for 2 cells must be refused"),
+            Err(e) => e,
+        };
+        assert!(
+            e.contains("short.vtu") && e.contains("`part_id`") && e.contains("2 values"),
+            "{e}"
+        );
+    }
+    std::fs::write(&p, two_cells_vtu("2147483647 0")).unwrap();
+    let m = read_mesh(&p, 1.0).unwrap().mesh;
+    assert_eq!(m.part_names, vec!["part_0", "part_2147483647"]);
+    assert_eq!(m.element_part, vec![1, 0]);
+}

@@ -30,6 +30,13 @@ pub struct Cli {
     command: Command,
 }
 
+impl Cli {
+    /// Whether the command is `serve` (which keeps writing to sockets that clients close).
+    pub fn is_serve(&self) -> bool {
+        matches!(self.command, Command::Serve(_))
+    }
+}
+
 #[derive(Subcommand)]
 enum Command {
     /// The main job: press the two-finger hand 15 mm into the built-in abdomen phantom with the

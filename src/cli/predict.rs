@@ -16,7 +16,8 @@
 //!   and writes one JSON line per input line, flushed at once:
 //!   `{"line": 1, "stress": [...], "variance": null}` (`variance` [Pa^2] for a GP: the latent
 //!   variance shared by its raw outputs, on the tensor target by every stress component). A line that
-//!   cannot be used gets `{"line": N, "error": "..."}` and the stream goes on; blank lines are
+//!   cannot be used (malformed JSON, invalid UTF-8, a non-finite prediction from a damaged
+//!   model) gets `{"line": N, "error": "..."}` and the stream goes on; blank lines are
 //!   skipped. A closed stdout (the reader has gone) ends the stream quietly. The model is
 //!   loaded once ([`surrogate::Predictor`], the hand-written forward pass).
 
@@ -101,6 +102,23 @@ fn check_finite(name: &str, v: f64) -> Result<f64, String> {
     }
 }
 
+/// A prediction with a NaN or infinite stress or variance (a damaged model) is an error, not
+/// an answer.
+fn non_finite_output(stress: &[f64], variance: Option<f64>) -> Result<(), String> {
+    if let Some(i) = stress.iter().position(|v| !v.is_finite()) {
+        return Err(format!(
+            "the model predicts a non-finite stress ({}) for ROI output {i}: the model file is damaged",
+            stress[i]
+        ));
+    }
+    match variance {
+        Some(v) if !(v.is_finite() && v >= 0.0) => Err(format!(
+            "the model predicts a variance of {v}: the model file is damaged"
+        )),
+        _ => Ok(()),
+    }
+}
+
 /// One-shot prediction: print the vector, optionally render the map.
 pub fn predict_one(
     model: &Path,
@@ -116,6 +134,7 @@ pub fn predict_one(
     let meta = served.predictor.meta().clone();
     let prediction = served.predict(x, y, force);
     let stress = &prediction.stress;
+    non_finite_output(stress, None).map_err(|e| format!("model {}: {e}", model.display()))?;
     let mut text = format!(
         "{} model {} on the {} target ({}): {} ROI elements\nfinger at x = {x} m, y = {y} m, force = {force} N\n",
         meta.kind,
@@ -216,16 +235,40 @@ pub fn predict_stdin(model: &Path) -> Result<(), String> {
     let stdout = std::io::stdout();
     let mut out = stdout.lock();
     let (mut served, mut failed) = (0usize, 0usize);
-    for (k, line) in stdin.lock().lines().enumerate() {
-        let n = k + 1;
-        let line = line.map_err(|e| format!("reading stdin line {n}: {e}"))?;
-        if line.trim().is_empty() {
-            continue;
+    let mut input = stdin.lock();
+    let mut buf = Vec::new();
+    let mut n = 0usize;
+    loop {
+        buf.clear();
+        let got = input
+            .read_until(b'\n', &mut buf)
+            .map_err(|e| format!("reading stdin line {}: {e}", n + 1))?;
+        if got == 0 {
+            break;
         }
-        let reply = match parse_line(&line) {
-            Ok(([x, y, force], id)) => {
+        n += 1;
+        // A line that is not UTF-8 gets its error reply; the stream goes on.
+        let parsed = std::str::from_utf8(&buf)
+            .map_err(|e| format!("not valid UTF-8 ({e})"))
+            .and_then(|line| {
+                if line.trim().is_empty() {
+                    Ok(None)
+                } else {
+                    parse_line(line).map(Some)
+                }
+            });
+        let parsed = match parsed {
+            Ok(None) => continue,
+            Ok(Some(v)) => Ok(v),
+            Err(e) => Err(e),
+        };
+        let reply = match parsed.and_then(|([x, y, force], id)| {
+            let (stress, variance) = p.predict_with_variance(x, y, force);
+            non_finite_output(&stress, variance)?;
+            Ok((stress, variance, id))
+        }) {
+            Ok((stress, variance, id)) => {
                 served += 1;
-                let (stress, variance) = p.predict_with_variance(x, y, force);
                 let mut m = Map::new();
                 m.insert("line".into(), json!(n));
                 if let Some(id) = id {

@@ -1,4 +1,5 @@
-//! `palpa run SCENE --out DIR`.
+//! `palpa run SCENE --out DIR`. A run stopped by Ctrl-C keeps its complete output up to the
+//! stop and exits with status 130.
 
 use super::input::{load, print_report, DeckArgs};
 use super::progress::{stop_flag, time_bar};
@@ -81,9 +82,22 @@ pub fn run(scene_path: &Path, out: &Path, quiet: bool, deck: &DeckArgs) -> Resul
     println!("  output: {}", out.display());
     match err {
         Some(e) => Err(e),
+        None if summary.status == "stopped" => {
+            // Ctrl-C: the output up to the stop is complete, but the run is not.
+            eprintln!(
+                "stopped by Ctrl-C at {:.4} ms of {:.4} ms; {} holds the output up to there",
+                summary.time * 1e3,
+                scene.end_time * 1e3,
+                out.display()
+            );
+            std::process::exit(STOPPED_EXIT);
+        }
         None => Ok(()),
     }
 }
+
+/// The exit status of a run stopped by Ctrl-C (128 + SIGINT, as a shell reports it).
+pub const STOPPED_EXIT: i32 = 130;
 
 /// Run a built scene into `out` with a progress bar and Ctrl-C handling; print the added mass
 /// first. Returns the summary and the error, if the run failed.

@@ -75,6 +75,17 @@ pub fn read(path: &Path) -> Result<RawMesh, String> {
             break;
         }
     }
+    if part.is_none() {
+        // vtkio drops a cell array whose length does not match the cells: a part array the file
+        // declares but that did not come through is damaged, not absent (else every cell would
+        // silently fall into one part).
+        if let Some(name) = declared_cell_array(&bytes, &PART_ARRAYS) {
+            return Err(format!(
+                "{p}: cell array `{name}` could not be read as {} values, one per cell (the array is short, long or damaged)",
+                types.len()
+            ));
+        }
+    }
     match piece.cells.cell_verts {
         VertexNumbers::XML {
             connectivity,
@@ -106,6 +117,21 @@ pub fn read(path: &Path) -> Result<RawMesh, String> {
     let names = field_strings(&bytes, "part_names").map_err(|e| format!("{p}: {e}"))?;
     raw.part_names = names_from(names);
     Ok(raw)
+}
+
+/// The first of `names` that the file's `<CellData>` declares as a `DataArray`, if any.
+fn declared_cell_array<'a>(bytes: &[u8], names: &[&'a str]) -> Option<&'a str> {
+    let head_end = find(bytes, b"<AppendedData").unwrap_or(bytes.len());
+    let head = String::from_utf8_lossy(&bytes[..head_end]);
+    let start = head.find("<CellData")?;
+    let end = head[start..]
+        .find("</CellData>")
+        .map(|e| start + e)
+        .unwrap_or(head.len());
+    let section = &head[start..end];
+    names.iter().copied().find(|n| {
+        section.contains(&format!("Name=\"{n}\"")) || section.contains(&format!("Name='{n}'"))
+    })
 }
 
 /// The `<FieldData>` string array `name` of a VTK XML file's bytes, or nothing.

@@ -53,26 +53,42 @@ impl History {
     }
 }
 
-/// Read a history CSV back: (columns, rows).
+/// Read a history CSV back: (columns, rows). Every row must have exactly as many values as the
+/// header has columns (a file cut mid-row is an error naming the file and the line, not a panic
+/// later on when a column is looked up).
 pub fn read_history(path: &Path) -> Result<(Vec<String>, Vec<Vec<f64>>), String> {
     let s = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
     let mut lines = s.lines();
     let cols: Vec<String> = lines
         .next()
-        .ok_or("empty history")?
+        .ok_or_else(|| format!("{}: empty history (no header line)", path.display()))?
         .split(',')
         .map(|c| c.to_string())
         .collect();
-    let rows = lines
-        .map(|l| {
-            l.split(',')
-                .map(|x| {
-                    x.parse::<f64>()
-                        .map_err(|e| format!("{}: {e}", path.display()))
+    let mut rows = Vec::new();
+    for (k, l) in lines.enumerate() {
+        let line = k + 2;
+        let row = l
+            .split(',')
+            .map(|x| {
+                x.parse::<f64>().map_err(|e| {
+                    format!(
+                        "{} line {line}: value `{x}` is not a number: {e}",
+                        path.display()
+                    )
                 })
-                .collect()
-        })
-        .collect::<Result<Vec<Vec<f64>>, String>>()?;
+            })
+            .collect::<Result<Vec<f64>, String>>()?;
+        if row.len() != cols.len() {
+            return Err(format!(
+                "{} line {line}: {} values where the header has {} columns (file cut or damaged)",
+                path.display(),
+                row.len(),
+                cols.len()
+            ));
+        }
+        rows.push(row);
+    }
     Ok((cols, rows))
 }
 

@@ -197,6 +197,23 @@ fn read_mesh(
                     "a box needs `divisions`",
                 )
             })?;
+            let limit = spec
+                .max_elements
+                .map(|x| x.0)
+                .unwrap_or(crate::generate::DEFAULT_MAX_ELEMENTS);
+            let count = divisions.iter().map(|&d| d as f64).product::<f64>();
+            if count > limit {
+                return Err(err(
+                    scene,
+                    src,
+                    "mesh.divisions",
+                    Some("divisions"),
+                    format!(
+                        "{divisions:?} gives {count:.4e} elements, more than the limit of {limit:.0} (about {:.0} GiB of memory); use fewer divisions, or raise `[mesh] max_elements` if you mean it",
+                        count * crate::generate::BYTES_PER_ELEMENT / 1073741824.0
+                    ),
+                ));
+            }
             let b = BoxSpec {
                 origin: spec
                     .origin
@@ -327,6 +344,10 @@ pub fn build_scene_with(
     super::def::assemble(resolve_scene(spec, path, src, prebuilt)?)
 }
 
+/// The most history rows, or frames, a scene may ask for unless `[output] max_outputs` raises
+/// the limit.
+pub const DEFAULT_MAX_OUTPUTS: f64 = 1e6;
+
 /// Resolve a parsed scene to SI ([`SceneDef`]): the mesh with its node sets, the parts' laws,
 /// boundary conditions, loads, settings, output and contact. [`super::def::assemble`] builds
 /// the model from it.
@@ -342,6 +363,13 @@ pub fn resolve_scene(
     let end_time = spec.run.end_time.0;
     if !(end_time > 0.0) {
         return Err(e("run.end_time", Some("end_time"), &"must be positive"));
+    }
+    if !end_time.is_finite() {
+        return Err(e(
+            "run.end_time",
+            Some("end_time"),
+            &format!("must be finite, got {end_time}"),
+        ));
     }
     let dt_factor = spec
         .run
@@ -634,6 +662,48 @@ pub fn resolve_scene(
         .history_interval
         .map(|t| t.0)
         .unwrap_or(end_time / 500.0);
+    if !(history_interval >= 0.0 && history_interval.is_finite()) {
+        return Err(e(
+            "output.history_interval",
+            Some("history_interval"),
+            &format!(
+                "must be zero (every step) or a positive finite time, got {history_interval} s"
+            ),
+        ));
+    }
+    let max_outputs = match out.max_outputs.map(|x| x.0) {
+        None => DEFAULT_MAX_OUTPUTS,
+        Some(m) if m >= 1.0 && m.is_finite() => m,
+        Some(m) => {
+            return Err(e(
+                "output.max_outputs",
+                Some("max_outputs"),
+                &format!("must be a positive finite count, got {m}"),
+            ))
+        }
+    };
+    // Outputs on the interval grid: a tiny interval would write rows or frames without end
+    // (and stall the run) rather than fail.
+    let too_many = |key: &str, needle: &str, what: &str, interval: f64| {
+        let n = end_time / interval;
+        (interval > 0.0 && n > max_outputs).then(|| {
+            e(
+                key,
+                Some(needle),
+                &format!(
+                    "an interval of {interval:e} s over end_time {end_time:e} s gives {n:.3e} {what}, more than the limit of {max_outputs:.0}; use a longer interval, or raise `[output] max_outputs` if you mean it"
+                ),
+            )
+        })
+    };
+    if let Some(m) = too_many(
+        "output.history_interval",
+        "history_interval",
+        "history rows",
+        history_interval,
+    ) {
+        return Err(m);
+    }
     let probe = match &out.probe {
         None => None,
         Some(name) => {
@@ -652,6 +722,9 @@ pub fn resolve_scene(
     if !(frame_interval > 0.0) {
         return Err(e("output.interval", Some("interval"), &"must be positive"));
     }
+    if let Some(m) = too_many("output.interval", "interval", "frames", frame_interval) {
+        return Err(m);
+    }
     let plan = OutputPlan {
         vtk_interval,
         frame_interval: (vtk_interval.is_some() || probe.is_some()).then_some(frame_interval),
@@ -663,10 +736,20 @@ pub fn resolve_scene(
     // Settings.
     let bulk = match &spec.bulk_viscosity {
         Some(b) if b.enabled == Some(false) => None,
-        Some(b) => Some(BulkViscosity {
-            quadratic: b.quadratic.map(|x| x.0).unwrap_or(1.5),
-            linear: b.linear.map(|x| x.0).unwrap_or(0.06),
-        }),
+        Some(b) => {
+            let quadratic = b.quadratic.map(|x| x.0).unwrap_or(1.5);
+            let linear = b.linear.map(|x| x.0).unwrap_or(0.06);
+            for (key, v) in [("quadratic", quadratic), ("linear", linear)] {
+                if !(v >= 0.0 && v.is_finite()) {
+                    return Err(e(
+                        &format!("bulk_viscosity.{key}"),
+                        Some(key),
+                        &format!("must be zero or a positive finite coefficient, got {v}"),
+                    ));
+                }
+            }
+            Some(BulkViscosity { quadratic, linear })
+        }
         None => Some(BulkViscosity::default()),
     };
     let mass_scaling = spec.mass_scaling.as_ref().map(|m| MassScaling {
@@ -727,6 +810,17 @@ pub fn resolve_scene(
         dt_factor,
         dt_max: spec.run.dt_max.map(|t| t.0),
         dt_min: spec.run.dt_min.map(|t| DtMin::Time(t.0)),
+        max_steps: match spec.run.max_steps.map(|x| x.0) {
+            None => None,
+            Some(m) if m >= 1.0 && m.is_finite() => Some(m),
+            Some(m) => {
+                return Err(e(
+                    "run.max_steps",
+                    Some("max_steps"),
+                    &format!("must be a positive finite count, got {m}"),
+                ))
+            }
+        },
         hourglass_guard,
         bulk,
         damping,

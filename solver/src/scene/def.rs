@@ -124,6 +124,9 @@ pub struct Setup {
     pub dt_max: Option<f64>,
     /// Smallest step before the run stops (default: 1e-6 of the initial step).
     pub dt_min: Option<DtMin>,
+    /// The most steps the run may take by the estimate from its stable step (default
+    /// [`DEFAULT_MAX_STEPS`]).
+    pub max_steps: Option<f64>,
     /// Hourglass guard.
     pub hourglass_guard: Option<HourglassGuard>,
     /// Bulk viscosity.
@@ -160,6 +163,25 @@ pub struct SceneDef {
     pub notes: Vec<String>,
 }
 
+/// The most time steps a scene may take by the estimate of [`estimated_steps`] unless
+/// `[run] max_steps` raises the limit.
+pub const DEFAULT_MAX_STEPS: f64 = 1e9;
+/// The slowest initial wave speed (m/s) a material may have: a softer or heavier one is not a
+/// material but a typo (its stable step would outlast any run).
+pub const MIN_WAVE_SPEED: f64 = 1e-6;
+/// The fastest initial wave speed (m/s) a material may have (diamond's is about 1.8e4 m/s).
+pub const MAX_WAVE_SPEED: f64 = 1e6;
+
+/// Steps a run to `end_time` takes with the model's stable step at the start: the initial
+/// stable step, or the step fixed mass scaling raises it to, times the safety factor, capped by
+/// `dt_max`. At least 1. (Elements that shrink during the run lower the step further, so the
+/// run may take more.)
+pub fn estimated_steps(model: &Model, dt_factor: f64, dt_max: Option<f64>, end_time: f64) -> f64 {
+    let stable = model.scaled_dt.max(model.initial_dt.0);
+    let dt = (dt_factor * stable).min(dt_max.unwrap_or(f64::INFINITY));
+    (end_time / dt).ceil().max(1.0)
+}
+
 /// Build the model, the simulation and the contact stage of a resolved scene.
 pub fn assemble(def: SceneDef) -> Result<Scene, String> {
     let SceneDef {
@@ -181,8 +203,30 @@ pub fn assemble(def: SceneDef) -> Result<Scene, String> {
             formulation: p.formulation,
         })
         .collect();
+    for p in &setup.parts {
+        let c = p.material.initial_wave_speed();
+        if !(MIN_WAVE_SPEED..=MAX_WAVE_SPEED).contains(&c) {
+            return Err(format!(
+                "{}: part `{}`: its material ({}, density {:e} kg/m^3) has a wave speed of {c:.3e} m/s, outside [{MIN_WAVE_SPEED:e}, {MAX_WAVE_SPEED:e}] m/s: the modulus or the density is not physical, and the stable time step would be absurd",
+                path.display(),
+                p.name,
+                p.material.law_name(),
+                p.material.density()
+            ));
+        }
+    }
     let model = Model::build(mesh, parts, setup.mass_scaling, setup.dt_factor)
         .map_err(|m| format!("{}: {m}", path.display()))?;
+    let max_steps = setup.max_steps.unwrap_or(DEFAULT_MAX_STEPS);
+    let steps = estimated_steps(&model, setup.dt_factor, setup.dt_max, end_time);
+    if steps.is_nan() || steps > max_steps {
+        return Err(format!(
+            "{}: the run would take about {steps:.3e} time steps (stable step {:.3e} s at element {}, end time {end_time:e} s), more than the limit of {max_steps:.0}; check the moduli and densities, or raise `[run] max_steps` if you mean it",
+            path.display(),
+            setup.dt_factor * model.initial_dt.0,
+            model.initial_dt.1
+        ));
+    }
     let dt0 = model.scaled_dt.min(model.initial_dt.0);
     let settings = LoopSettings {
         dt_factor: setup.dt_factor,

@@ -73,6 +73,9 @@ pub struct RunSpec {
     pub max_hourglass_ratio: Option<Number>,
     /// From when the guard checks (default: 10 % of the end time).
     pub hourglass_check_after: Option<Time>,
+    /// The most time steps the run may take by the estimate from the stable step (default
+    /// [`crate::scene::def::DEFAULT_MAX_STEPS`]); a scene that would take more is refused.
+    pub max_steps: Option<Number>,
     /// A title.
     pub title: Option<String>,
 }
@@ -102,6 +105,9 @@ pub struct MeshSpec {
     pub seed: Option<u64>,
     /// Box: its part name (default `body`).
     pub part: Option<String>,
+    /// Box: the most elements it may have (default [`crate::generate::DEFAULT_MAX_ELEMENTS`]);
+    /// more divisions are refused before anything is allocated.
+    pub max_elements: Option<Number>,
     /// Phantom: `[mesh.phantom]` (with `generator = "phantom"`).
     pub phantom: Option<super::phantom_spec::PhantomScene>,
 }
@@ -295,4 +301,7 @@ pub struct OutputSpec {
     /// An element set (e.g. the phantom's `roi`) whose stresses are sampled at every frame
     /// time into `probe.csv` (maximum principal stress) and `probe_stress.csv` (tensors).
     pub probe: Option<String>,
+    /// The most history rows or frames the run may write (default
+    /// [`crate::scene::build::DEFAULT_MAX_OUTPUTS`]); a smaller interval is refused.
+    pub max_outputs: Option<Number>,
 }

@@ -77,9 +77,38 @@ fn header_affine(h: &NiftiHeader) -> [[f64; 4]; 4] {
     a
 }
 
-/// Read a label volume from `.nii` or `.nii.gz`.
+/// The nifti crate's error in words: its I/O variant prints as Rust (`Io(Kind(UnexpectedEof))`).
+fn nifti_message(e: &nifti::NiftiError) -> String {
+    match e {
+        nifti::NiftiError::Io(io) if io.kind() == std::io::ErrorKind::UnexpectedEof => {
+            "the file ends early (truncated: the header or the voxel data is incomplete)".into()
+        }
+        nifti::NiftiError::Io(io) => format!("cannot read the file: {io}"),
+        other => other.to_string(),
+    }
+}
+
+/// Read a `.gz` file through to its end, so that its CRC-32 and length trailer are checked: a
+/// damaged stream the NIfTI reader would otherwise mesh into different anatomy is an error.
+fn check_gzip(path: &Path) -> Result<(), String> {
+    let f =
+        std::fs::File::open(path).map_err(|e| format!("{}: cannot read: {e}", path.display()))?;
+    let mut gz = flate2::read::MultiGzDecoder::new(std::io::BufReader::new(f));
+    std::io::copy(&mut gz, &mut std::io::sink()).map_err(|e| {
+        format!(
+            "{}: the gzip stream is damaged ({e}); the file is corrupt or truncated",
+            path.display()
+        )
+    })?;
+    Ok(())
+}
+
+/// Read a label volume from `.nii` or `.nii.gz`; a `.gz` file's checksum is verified.
 pub fn read_nifti(path: &Path) -> Result<LabelVolume, String> {
-    let err = |e: nifti::NiftiError| format!("{}: {e}", path.display());
+    let err = |e: nifti::NiftiError| format!("{}: {}", path.display(), nifti_message(&e));
+    if path.to_string_lossy().to_ascii_lowercase().ends_with(".gz") {
+        check_gzip(path)?;
+    }
     let obj = ReaderOptions::new().read_file(path).map_err(err)?;
     let h = obj.header().clone();
     let nd = h.dim[0] as usize;
