@@ -16,5 +16,6 @@ if ! command -v chromium >/dev/null 2>&1; then
 fi
 echo "   $(chromium --version 2>/dev/null | tail -n 1)"
 
-# the test profile, already built by `cargo test --workspace`; one test at a time
-PALPA_CHROMIUM="$(command -v chromium)" cargo test --quiet -p palpa --test browser -- --nocapture --test-threads=1
+# the test profile, already built by `cargo test --workspace` (`--workspace` here too: `-p palpa`
+# resolves features without the benches member and rebuilds half the tree); one test at a time
+PALPA_CHROMIUM="$(command -v chromium)" cargo test --quiet --workspace --test browser -- --nocapture --test-threads=1
