@@ -5,26 +5,9 @@
 use std::path::Path;
 use std::process::Command;
 
-const GOOD: &str = r#"
-[run]
-end_time = "1 ms"
-[mesh]
-generator = "box"
-size = ["10 mm", "10 mm", "10 mm"]
-divisions = [2, 2, 2]
-part = "block"
-[materials.rubber]
-law = "neo_hookean"
-density = "1000 kg/m^3"
-youngs_modulus = "1 MPa"
-poisson_ratio = 0.3
-[[part]]
-name = "block"
-material = "rubber"
-[[boundary]]
-nodes = "zmin"
-fix = ["all"]
-"#;
+#[path = "support/block.rs"]
+mod block;
+use block::BLOCK as GOOD;
 
 /// A fresh temporary directory, removed when the returned guard drops.
 fn dir(name: &str) -> tempfile::TempDir {

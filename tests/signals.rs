@@ -10,30 +10,12 @@ use std::os::unix::process::ExitStatusExt;
 use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 
-const SCENE: &str = r#"
-[run]
-end_time = "END"
-[mesh]
-generator = "box"
-size = ["10 mm", "10 mm", "10 mm"]
-divisions = [2, 2, 2]
-part = "block"
-[materials.rubber]
-law = "neo_hookean"
-density = "1000 kg/m^3"
-youngs_modulus = "1 MPa"
-poisson_ratio = 0.3
-[[part]]
-name = "block"
-material = "rubber"
-[[boundary]]
-nodes = "zmin"
-fix = ["all"]
-"#;
+#[path = "support/block.rs"]
+mod block;
 
 fn scene(dir: &std::path::Path, end: &str) -> std::path::PathBuf {
     let p = dir.join("s.toml");
-    std::fs::write(&p, SCENE.replace("END", end)).unwrap();
+    std::fs::write(&p, block::BLOCK.replace("\"1 ms\"", &format!("\"{end}\""))).unwrap();
     p
 }
 

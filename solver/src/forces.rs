@@ -122,19 +122,20 @@ pub fn element_loop(
     force: &mut [[f64; 3]],
     stress: Option<&mut [[f64; 6]]>,
 ) -> Result<ElementTotals, (u32, String)> {
-    // The kernels index these arrays by the connectivity without bounds checks (the model
-    // checked every element's nodes against its mesh when it was built).
+    // The kernels index these arrays by the connectivity without bounds checks: O(groups)
+    // checks against what the model recorded when it was built.
     let n_nodes = x_ref.len();
     assert!(
         u.len() == n_nodes && v.len() == n_nodes && force.len() == n_nodes,
         "element_loop: u, v and force need one entry per node of x_ref"
     );
     assert!(
-        groups.iter().all(|g| g.max_node() < n_nodes),
+        groups.iter().all(|g| g.max_node < n_nodes),
         "element_loop: an element refers to a node beyond x_ref"
     );
     if let Some(s) = &stress {
-        let ne = groups.iter().flat_map(|g| g.elements.iter()).max();
+        // A group's global ids ascend (the model collects them in mesh order).
+        let ne = groups.iter().filter_map(|g| g.elements.last()).max();
         assert!(
             ne.is_none_or(|&e| (e as usize) < s.len()),
             "element_loop: stress is too short"

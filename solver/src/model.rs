@@ -163,6 +163,10 @@ pub struct Group {
     /// force array in parallel without a race, and every node receives its contributions in
     /// the same order (colour, then element order within its chunk) on any thread count.
     pub(crate) colours: Vec<Vec<u32>>,
+    /// Largest node index of the group's elements, found once when the model is built: the
+    /// element loop checks it against the nodal arrays it is given (its kernels index them
+    /// without bounds checks).
+    pub(crate) max_node: usize,
     /// Scratch: per-chunk partial results.
     pub chunks: Vec<ChunkOut>,
     /// Eroded flags (empty unless the law can fail).
@@ -183,11 +187,6 @@ pub struct Group {
 pub const CHUNK: usize = 512;
 
 impl Group {
-    /// Largest node index of the group's elements (0 for an empty group).
-    pub fn max_node(&self) -> usize {
-        self.conn.iter().flatten().copied().max().unwrap_or(0) as usize
-    }
-
     /// The element loop's colouring (see [`Group::colours`]): the number of colours and the
     /// fewest chunks any colour has (the parallelism the element loop can use).
     pub fn colouring(&self) -> (usize, usize) {
@@ -512,6 +511,7 @@ impl Model {
                 history: vec![F64x8::splat(0.0); stride * n.div_ceil(LANES)],
                 density_scale: Vec::new(),
                 colours: Vec::new(),
+                max_node: 0,
                 chunks: vec![ChunkOut::default(); n.div_ceil(CHUNK)],
                 eroded: Vec::new(),
                 dt_kappa: 1.0,
@@ -631,6 +631,7 @@ impl Model {
                 }
             }
             g.colours = colour_chunks(&g.conn, mesh.nodes.len());
+            g.max_node = g.conn.iter().flatten().copied().max().unwrap_or(0) as usize;
             groups.push(g);
         }
         if let Some(ms) = mass_scaling {
