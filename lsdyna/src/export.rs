@@ -715,7 +715,7 @@ pub fn export(scene: &Scene, opts: &ExportOptions) -> Result<Exported, String> {
         let (elform, ihq, qm, element_note) = match p.formulation {
             Formulation::OnePoint(h) => {
                 let ratio = match (h.modulus, h.form) {
-                    (HourglassModulus::PWave, _) => 1.0,
+                    (_, HourglassForm::Physical) | (HourglassModulus::PWave, _) => 1.0,
                     (HourglassModulus::Shear, HourglassForm::Viscous) => {
                         (two_mu / lambda2mu).sqrt()
                     }
@@ -724,26 +724,41 @@ pub fn export(scene: &Scene, opts: &ExportOptions) -> Result<Exported, String> {
                 let form = match h.form {
                     HourglassForm::Viscous => "viscous",
                     HourglassForm::Stiffness => "stiffness",
+                    HourglassForm::Physical => "physical",
+                };
+                let ihq = match h.form {
+                    HourglassForm::Viscous => 2,
+                    HourglassForm::Stiffness => 4,
+                    HourglassForm::Physical => 6,
                 };
                 let modulus = match h.modulus {
                     HourglassModulus::PWave => "p_wave",
                     HourglassModulus::Shear => "shear",
                 };
-                if h.modulus == HourglassModulus::Shear {
+                if h.form == HourglassForm::Physical {
                     notes.push(format!(
-                        "part `{}`: shear-scaled {form} hourglass control Q = {} written as LS-DYNA type {} with the equivalent QM = {:.6e}",
+                        "part `{}`: physical hourglass control Q = {} written as LS-DYNA type 6 (Belytschko-Bindeman assumed strain, co-rotational rate form; palpa's is total Lagrangian, the two agree to first order)",
+                        p.name, h.coefficient
+                    ));
+                } else if h.modulus == HourglassModulus::Shear {
+                    notes.push(format!(
+                        "part `{}`: shear-scaled {form} hourglass control Q = {} written as LS-DYNA type {ihq} with the equivalent QM = {:.6e}",
                         p.name,
                         h.coefficient,
-                        if h.form == HourglassForm::Viscous { 2 } else { 4 },
                         h.coefficient * ratio
                     ));
                 }
+                let keys = if h.form == HourglassForm::Physical {
+                    String::new()
+                } else {
+                    format!(", hourglass_modulus = \"{modulus}\"")
+                };
                 (
                     1,
-                    if h.form == HourglassForm::Viscous { 2 } else { 4 },
+                    ihq,
                     h.coefficient * ratio,
                     format!(
-                        "{{ formulation = \"one_point\", hourglass = \"{form}\", hourglass_coefficient = {}, hourglass_modulus = \"{modulus}\" }}",
+                        "{{ formulation = \"one_point\", hourglass = \"{form}\", hourglass_coefficient = {}{keys} }}",
                         tn(h.coefficient)
                     ),
                 )

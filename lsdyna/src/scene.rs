@@ -1253,6 +1253,7 @@ fn part_def(cx: &mut Ctx, p: &PartInfo, name: &str) -> Result<PartDef, String> {
         material,
         spec,
         formulation,
+        bulk: None,
     })
 }
 
@@ -1483,12 +1484,18 @@ fn element(cx: &mut Ctx, p: &PartInfo, material: &Material) -> Result<Formulatio
             let form = match ihq {
                 1..=3 => HourglassForm::Viscous,
                 4 | 5 => HourglassForm::Stiffness,
+                6 => HourglassForm::Physical,
                 o => {
                     return Err(format!(
-                        "{hg_at}: hourglass type IHQ = {o} is not supported (palpa: 1-3 viscous, 4-5 stiffness, Flanagan-Belytschko, scaled by the P-wave modulus)"
+                        "{hg_at}: hourglass type IHQ = {o} is not supported (palpa: 1-3 viscous, 4-5 stiffness, Flanagan-Belytschko, scaled by the P-wave modulus; 6 physical, assumed strain)"
                     ))
                 }
             };
+            if form == HourglassForm::Physical {
+                cx.warn.push(format!(
+                    "{hg_at}: IHQ = 6 read as palpa's physical hourglass form with QM = {qm} as its coefficient (Belytschko-Bindeman assumed strain in total Lagrangian form; LS-DYNA integrates type 6 in co-rotational rate form, the two agree to first order)"
+                ));
+            }
             if !(0.0..=1.0).contains(&qm) {
                 return Err(format!("{hg_at}: hourglass coefficient QM must lie in [0, 1], got {qm}"));
             }
@@ -1530,15 +1537,18 @@ fn element(cx: &mut Ctx, p: &PartInfo, material: &Material) -> Result<Formulatio
             let form = match note.hourglass.as_deref() {
                 None | Some("viscous") => HourglassForm::Viscous,
                 Some("stiffness") => HourglassForm::Stiffness,
+                Some("physical") => HourglassForm::Physical,
                 _ => h.form,
             };
             let modulus = match note.hourglass_modulus.as_deref() {
                 Some("shear") => HourglassModulus::Shear,
                 _ => HourglassModulus::PWave,
             };
-            let q = note.hourglass_coefficient.unwrap_or(0.1);
+            let q = note
+                .hourglass_coefficient
+                .unwrap_or(if form == HourglassForm::Physical { 1.0 } else { 0.1 });
             let ratio = match (modulus, form) {
-                (HourglassModulus::PWave, _) => 1.0,
+                (_, HourglassForm::Physical) | (HourglassModulus::PWave, _) => 1.0,
                 (HourglassModulus::Shear, HourglassForm::Viscous) => (two_mu / lambda2mu).sqrt(),
                 (HourglassModulus::Shear, HourglassForm::Stiffness) => two_mu / lambda2mu,
             };

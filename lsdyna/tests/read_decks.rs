@@ -351,3 +351,31 @@ punch
         "{w}"
     );
 }
+
+#[test]
+fn hourglass_type_6_reads_as_the_physical_form_and_7_is_refused() {
+    use solver::element::{Formulation, HourglassForm};
+    let dir = tempfile::tempdir().unwrap();
+    let p = write(
+        dir.path(),
+        "ihq6.k",
+        &prepost_deck("*CONTROL_HOURGLASS\n         6       1.0\n"),
+    );
+    let (def, report) = read_deck(&p, &kg_mm_ms()).unwrap();
+    match def.setup.parts[0].formulation {
+        Formulation::OnePoint(h) => {
+            assert_eq!(h.form, HourglassForm::Physical);
+            assert_eq!(h.coefficient, 1.0);
+        }
+        f => panic!("{f:?}"),
+    }
+    let w = report.warnings.join("\n");
+    assert!(w.contains("IHQ = 6") && w.contains("physical"), "{w}");
+    let p = write(
+        dir.path(),
+        "ihq7.k",
+        &prepost_deck("*CONTROL_HOURGLASS\n         7       1.0\n"),
+    );
+    let e = fails(&p, &kg_mm_ms()).to_string();
+    assert!(e.contains("IHQ = 7") && e.contains("ihq7.k"), "{e}");
+}

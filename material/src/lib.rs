@@ -85,4 +85,32 @@ impl Material {
             Material::PiecewiseLinearPlasticity(_) => "piecewise_linear_plasticity",
         }
     }
+    /// Small-strain bulk modulus K (Pa): `lambda + 2 mu / 3` for the Lame-constant laws, the
+    /// law's `K` otherwise.
+    pub fn bulk_modulus(&self) -> f64 {
+        match self {
+            Material::LinearElastic(l) => l.lambda + 2.0 / 3.0 * l.mu,
+            Material::NeoHookean(l) => l.lambda + 2.0 / 3.0 * l.mu,
+            Material::Ogden(l) => l.bulk,
+            Material::SimplifiedRubber(l) => l.bulk,
+            Material::PiecewiseLinearPlasticity(l) => l.bulk,
+        }
+    }
+    /// The same law with the small-strain bulk modulus `k` (Pa) and every shear and history
+    /// parameter unchanged: the incompressibility knob of a scene (see `max_bulk_ratio` and
+    /// `bulk_modulus` under `[[part]]`). The wave speed, and so the stable step, follow it.
+    pub fn with_bulk_modulus(&self, k: f64) -> Result<Material, String> {
+        if !(k > 0.0 && k.is_finite()) {
+            return Err(format!("the bulk modulus must be positive and finite, got {k:e} Pa"));
+        }
+        let mut m = self.clone();
+        match &mut m {
+            Material::LinearElastic(l) => l.lambda = k - 2.0 / 3.0 * l.mu,
+            Material::NeoHookean(l) => l.lambda = k - 2.0 / 3.0 * l.mu,
+            Material::Ogden(l) => l.bulk = k,
+            Material::SimplifiedRubber(l) => l.bulk = k,
+            Material::PiecewiseLinearPlasticity(l) => l.bulk = k,
+        }
+        Ok(m)
+    }
 }

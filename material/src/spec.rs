@@ -280,6 +280,33 @@ impl IsotropicSpec {
 }
 
 impl MaterialSpec {
+    /// The same card with the small-strain bulk modulus `k` (Pa), given the law's shear modulus
+    /// `g` (Pa): isotropic cards become `shear_modulus` + `bulk_modulus`, an Ogden card states
+    /// `bulk_modulus` instead of a Poisson ratio, a plasticity card gets the Young's modulus and
+    /// Poisson ratio of (`k`, `g`). It describes [`crate::Material::with_bulk_modulus`], so an
+    /// exported deck carries the bulk modulus that ran.
+    pub fn with_bulk_modulus(&self, k: f64, g: f64) -> MaterialSpec {
+        let mut s = self.clone();
+        match &mut s {
+            MaterialSpec::LinearElastic(i) | MaterialSpec::NeoHookean(i) => {
+                i.youngs_modulus = None;
+                i.poisson_ratio = None;
+                i.shear_modulus = Some(Pressure(g));
+                i.bulk_modulus = Some(Pressure(k));
+            }
+            MaterialSpec::Ogden(o) => {
+                o.poisson_ratio = None;
+                o.bulk_modulus = Some(Pressure(k));
+            }
+            MaterialSpec::SimplifiedRubber(f) => f.bulk_modulus = Pressure(k),
+            MaterialSpec::PiecewiseLinearPlasticity(p) => {
+                p.youngs_modulus = Pressure(9.0 * k * g / (3.0 * k + g));
+                p.poisson_ratio = Number((3.0 * k - 2.0 * g) / (2.0 * (3.0 * k + g)));
+            }
+        }
+        s
+    }
+
     /// Validate and build the law (a `curve_file` is read relative to the working directory).
     pub fn build(&self, name: &str) -> Result<Material, String> {
         self.build_in(name, None)

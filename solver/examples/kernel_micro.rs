@@ -35,6 +35,7 @@ macro_rules! run {
             gamma: &gamma,
             vol0: <$R>::splat(2.7e-8),
             hg_scale: <$R>::splat(1.0),
+            physical: None,
         };
         let input = StepInput {
             dt: 1e-6,

@@ -25,6 +25,7 @@
 //! reduced serially in chunk order, and inside a chunk element by element in element order, for
 //! the same reason.
 
+use crate::element::physical::PhysicalRef;
 use crate::element::{fault_error, full, one_point, ElementOut, Formulation, Nodal, StepInput};
 use crate::model::{ChunkOut, Group, Part, CHUNK};
 use material::real::{F64x8, Mask, Real, LANES};
@@ -267,6 +268,13 @@ fn run_chunk_body<L: Law, G: GatherLanes>(l: &L, b: &Batch, ci: usize) -> ChunkO
                     gamma: &g.gamma[bi],
                     vol0: lanes_of(&g.vol0, le0),
                     hg_scale: lanes_of(&g.hg_scale, le0),
+                    physical: (!g.hg_frame.is_empty()).then(|| PhysicalRef {
+                        frame: &g.hg_frame[bi],
+                        inv_len: &g.hg_inv_len[bi],
+                        young: g.hg_moduli[0],
+                        poisson: g.hg_moduli[1],
+                        shear: g.hg_moduli[2],
+                    }),
                 };
                 one_point::compute_forces(l, &rf, hg.form, &xe, &ue, &ve, s, b.input, h, fe)
             }

@@ -16,7 +16,7 @@
 //! The added mass is reported per part.
 
 use crate::element::{max_face_area, Nodal};
-use crate::element::{surface_mode_factor, Formulation, HourglassForm, HourglassModulus};
+use crate::element::{physical, surface_mode_factor, Formulation, HourglassForm, HourglassModulus};
 use crate::hex::{element_geometry, hourglass_gamma};
 use crate::mesh::Mesh;
 use material::real::{F64x8, Real, LANES};
@@ -144,8 +144,15 @@ pub struct Group {
     /// Hourglass vectors (one-point only), per batch.
     pub gamma: Vec<[[F64x8; 8]; 4]>,
     /// Hourglass scale per element (one-point only): a_s (N/m) for the stiffness form,
-    /// Q rho0 V0^(2/3) / 4 (kg/m) for the viscous form.
+    /// Q rho0 V0^(2/3) / 4 (kg/m) for the viscous form, Q V0 / 3 (m^3) for the physical form.
     pub hg_scale: Vec<f64>,
+    /// Element frames `R0` of the physical hourglass form, per batch (empty for other forms).
+    pub hg_frame: Vec<[[F64x8; 3]; 3]>,
+    /// Inverse half-lengths of the physical form's elements (1/m), per batch.
+    pub hg_inv_len: Vec<[F64x8; 3]>,
+    /// Young's modulus (Pa), Poisson's ratio and shear modulus (Pa) of the physical form (the
+    /// law's initial ones).
+    pub hg_moduli: [f64; 3],
     /// Gauss-point gradients (full only), per batch.
     pub gp_grad: Vec<[Nodal<F64x8>; 8]>,
     /// Gauss-point weights (full only), per batch.
@@ -505,6 +512,9 @@ impl Model {
                 vol0: Vec::with_capacity(n),
                 gamma: Vec::new(),
                 hg_scale: Vec::new(),
+                hg_frame: Vec::new(),
+                hg_inv_len: Vec::new(),
+                hg_moduli: [0.0; 3],
                 gp_grad: Vec::new(),
                 gp_weight: Vec::new(),
                 history_stride: stride,
@@ -521,6 +531,7 @@ impl Model {
             let mut scale = Vec::with_capacity(n);
             let mut grad: Vec<Nodal> = Vec::with_capacity(n);
             let mut gamma: Vec<[[f64; 8]; 4]> = Vec::new();
+            let mut frames: Vec<([[f64; 3]; 3], [f64; 3])> = Vec::new();
             let mut gp_grad: Vec<[Nodal; 8]> = Vec::new();
             let mut gp_weight: Vec<[f64; 8]> = Vec::new();
             let lambda2mu = rho * c0 * c0;
@@ -537,6 +548,11 @@ impl Model {
                 }
                 _ => (lambda2mu, 1.0),
             };
+            if matches!(form, Formulation::OnePoint(h) if h.form == HourglassForm::Physical) {
+                let mu = law.initial_shear_modulus();
+                let (e, nu) = physical::young_poisson(lambda2mu, mu);
+                g.hg_moduli = [e, nu, mu];
+            }
             for &e in &elems {
                 let conn = mesh.elements[e as usize];
                 let x: [[f64; 3]; 8] = std::array::from_fn(|a| mesh.nodes[conn[a] as usize]);
@@ -553,7 +569,17 @@ impl Model {
                     Formulation::OnePoint(hg) => {
                         grad.push(geo.mean_grad);
                         gamma.push(hourglass_gamma(&x, &geo.mean_grad));
-                        if hg.form == HourglassForm::Stiffness {
+                        if hg.form == HourglassForm::Physical {
+                            frames.push(physical::element_frame(&x).ok_or_else(|| {
+                                SolverError::InvertedElement {
+                                    element: e,
+                                    part: part.name.clone(),
+                                    corner: 0,
+                                    det: 0.0,
+                                }
+                            })?);
+                            g.hg_scale.push(hg.coefficient * geo.volume / 3.0);
+                        } else if hg.form == HourglassForm::Stiffness {
                             let mut bb = 0.0;
                             for i in 0..3 {
                                 for a in 0..8 {
@@ -614,6 +640,10 @@ impl Model {
             g.gamma = batched(&gamma, |e| {
                 std::array::from_fn(|k| std::array::from_fn(|a| lanes(|l| e[l][k][a])))
             });
+            g.hg_frame = batched(&frames, |e| {
+                std::array::from_fn(|i| std::array::from_fn(|j| lanes(|l| e[l].0[i][j])))
+            });
+            g.hg_inv_len = batched(&frames, |e| std::array::from_fn(|j| lanes(|l| e[l].1[j])));
             g.gp_grad = batched(&gp_grad, |e| {
                 std::array::from_fn(|gp| {
                     std::array::from_fn(|i| std::array::from_fn(|a| lanes(|l| e[l][gp][i][a])))

@@ -44,28 +44,33 @@ pub enum ElementChoice {
     /// One-point integration with stiffness hourglass control scaled by the shear modulus
     /// (in the spirit of LS-DYNA type 6).
     OnePointStiffnessShear,
+    /// One-point integration with physical (assumed-strain) hourglass stabilisation, Q = 1
+    /// (in the spirit of LS-DYNA type 6, see [`crate::element::physical`]).
+    OnePointPhysical,
     /// Fully integrated 2x2x2 with F-bar.
     FullFbar,
 }
 
 impl ElementChoice {
     /// Every choice, in table order.
-    pub const ALL: [ElementChoice; 5] = [
+    pub const ALL: [ElementChoice; 6] = [
         ElementChoice::OnePointViscous,
         ElementChoice::OnePointStiffness,
         ElementChoice::OnePointViscousShear,
         ElementChoice::OnePointStiffnessShear,
+        ElementChoice::OnePointPhysical,
         ElementChoice::FullFbar,
     ];
     /// The hourglass control of a one-point choice; `None` for F-bar.
     pub fn hourglass(&self) -> Option<(HourglassForm, HourglassModulus)> {
-        use HourglassForm::{Stiffness, Viscous};
+        use HourglassForm::{Physical, Stiffness, Viscous};
         use HourglassModulus::{PWave, Shear};
         match self {
             ElementChoice::OnePointViscous => Some((Viscous, PWave)),
             ElementChoice::OnePointStiffness => Some((Stiffness, PWave)),
             ElementChoice::OnePointViscousShear => Some((Viscous, Shear)),
             ElementChoice::OnePointStiffnessShear => Some((Stiffness, Shear)),
+            ElementChoice::OnePointPhysical => Some((Physical, Shear)),
             ElementChoice::FullFbar => None,
         }
     }
@@ -73,11 +78,15 @@ impl ElementChoice {
     fn scene_keys(&self) -> String {
         match self.hourglass() {
             None => "formulation = \"full_fbar\"".into(),
+            Some((HourglassForm::Physical, _)) => {
+                "formulation = \"one_point\", hourglass = \"physical\", hourglass_coefficient = 1.0"
+                    .into()
+            }
             Some((form, modulus)) => format!(
                 "formulation = \"one_point\", hourglass = \"{}\", hourglass_modulus = \"{}\"",
                 match form {
                     HourglassForm::Viscous => "viscous",
-                    HourglassForm::Stiffness => "stiffness",
+                    _ => "stiffness",
                 },
                 match modulus {
                     HourglassModulus::PWave => "p_wave",
@@ -93,6 +102,7 @@ impl ElementChoice {
             ElementChoice::OnePointStiffness => "1pt-stiffness",
             ElementChoice::OnePointViscousShear => "1pt-viscous-shear",
             ElementChoice::OnePointStiffnessShear => "1pt-stiffness-shear",
+            ElementChoice::OnePointPhysical => "1pt-physical",
             ElementChoice::FullFbar => "full-fbar",
         }
     }
@@ -107,10 +117,11 @@ impl std::str::FromStr for ElementChoice {
             "1pt-stiffness" | "stiffness" => Ok(ElementChoice::OnePointStiffness),
             "1pt-viscous-shear" | "viscous-shear" => Ok(ElementChoice::OnePointViscousShear),
             "1pt-stiffness-shear" | "stiffness-shear" => Ok(ElementChoice::OnePointStiffnessShear),
+            "1pt-physical" | "physical" => Ok(ElementChoice::OnePointPhysical),
             "full_fbar" | "full-fbar" | "full" => Ok(ElementChoice::FullFbar),
             o => Err(format!(
                 "unknown element formulation `{o}` (one_point, 1pt-viscous, 1pt-stiffness, \
-                 1pt-viscous-shear, 1pt-stiffness-shear, full_fbar)"
+                 1pt-viscous-shear, 1pt-stiffness-shear, 1pt-physical, full_fbar)"
             )),
         }
     }
@@ -169,6 +180,9 @@ pub struct PalpationSetup {
     pub mass_scaling_limit: f64,
     /// Time-step safety factor.
     pub dt_factor: f64,
+    /// The incompressibility knob: cap every part's bulk modulus at this multiple of its
+    /// initial shear modulus (`max_bulk_ratio` of each `[[part]]`); `None` keeps the laws'.
+    pub max_bulk_ratio: Option<f64>,
     /// Write VTK frames.
     pub vtk: bool,
 }
@@ -194,6 +208,7 @@ impl Default for PalpationSetup {
             mass_scaling: Some(StepTarget::Initial(1.0)),
             mass_scaling_limit: 0.05,
             dt_factor: crate::simulation::DEFAULT_DT_FACTOR,
+            max_bulk_ratio: None,
             vtk: true,
         }
     }
@@ -303,12 +318,17 @@ impl PalpationSetup {
         s.push('\n');
         let el = |part: &str| {
             let tumour = crate::phantom::is_tumour_part(part);
-            self.part_elements
+            let keys = self
+                .part_elements
                 .get(part)
                 .or_else(|| tumour.then(|| self.part_elements.get("liver")).flatten())
                 .unwrap_or(&self.element)
                 .scene_keys()
-                .replace(", ", "\n")
+                .replace(", ", "\n");
+            match self.max_bulk_ratio {
+                Some(r) => format!("{keys}\nmax_bulk_ratio = {r:?}"),
+                None => keys,
+            }
         };
         let parts = [
             ("flesh", "paper:flesh"),

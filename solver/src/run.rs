@@ -78,6 +78,8 @@ pub struct RunSummary {
     pub stage_times: Vec<StageShare>,
     /// Mass per part.
     pub mass: Vec<PartMassReport>,
+    /// Parts whose bulk modulus the scene changed (the incompressibility knob).
+    pub bulk_modulus: Vec<crate::scene::def::BulkChange>,
     /// Threads used.
     pub threads: usize,
     /// Frames written.
@@ -487,6 +489,7 @@ pub fn run_scene(
                 added_percent: 100.0 * p.added / p.physical.max(1e-300),
             })
             .collect(),
+        bulk_modulus: scene.setup.parts.iter().filter_map(|p| p.bulk.clone()).collect(),
         threads: rayon::current_num_threads(),
         frames: series.len(),
         eroded_elements: sim.erosion.count,

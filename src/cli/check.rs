@@ -58,6 +58,9 @@ pub fn check(path: &Path, deck: &DeckArgs) -> Result<(), String> {
             pm.physical
         );
     }
+    for b in scene.setup.parts.iter().filter_map(|p| p.bulk.as_ref()) {
+        println!("  bulk modulus: {}", b.describe());
+    }
     let (dt0, e0) = m.initial_dt;
     let f = sim.settings.dt_factor;
     println!(

@@ -57,7 +57,8 @@ pub struct PalpateArgs {
     pub phase: f64,
     /// Element formulation: one_point (= 1pt-viscous-shear: one-point, viscous hourglass
     /// control scaled by the shear modulus), 1pt-viscous or 1pt-stiffness (hourglass scaled by
-    /// the P-wave modulus, LS-DYNA types 1 and 4), 1pt-stiffness-shear, or full_fbar.
+    /// the P-wave modulus, LS-DYNA types 1 and 4), 1pt-stiffness-shear, 1pt-physical
+    /// (assumed-strain stabilisation, in the spirit of LS-DYNA type 6), or full_fbar.
     #[arg(long, default_value = "one_point")]
     pub element: String,
     /// Selective mass scaling: `initial` (default: an element gets mass only when it shrinks
@@ -68,6 +69,11 @@ pub struct PalpateArgs {
     /// Time-step safety factor.
     #[arg(long, default_value_t = solver::simulation::DEFAULT_DT_FACTOR)]
     pub dt_factor: f64,
+    /// The incompressibility knob: cap every part's bulk modulus at this multiple of its
+    /// initial shear modulus (K/G; the paper's flesh has 5e4). The dilatational wave, and so
+    /// the stable step, follow; the summary states the change. Default: the laws' own.
+    #[arg(long)]
+    pub max_bulk_ratio: Option<f64>,
     /// Skip the VTK frames.
     #[arg(long)]
     pub no_vtk: bool,
@@ -119,6 +125,7 @@ impl PalpateArgs {
         s.mass_scaling = solver::model::StepTarget::parse_switch(&self.mass_scaling)
             .map_err(|e| format!("--mass-scaling: {e}"))?;
         s.dt_factor = self.dt_factor;
+        s.max_bulk_ratio = self.max_bulk_ratio;
         s.vtk = !self.no_vtk;
         s.title = match &s.place {
             Place::Named(n) => format!("palpation at {n}"),

@@ -48,6 +48,9 @@ pub fn print_summary(s: &RunSummary) {
             m.part, m.physical_kg, m.added_kg, m.added_percent
         );
     }
+    for b in &s.bulk_modulus {
+        println!("  bulk modulus: {}", b.describe());
+    }
     if let Some(e) = &s.first_eroded {
         println!(
             "  eroded elements: {} (the first, element {} of part `{}`, at {:.4} ms)",

@@ -18,6 +18,7 @@
 
 pub mod full;
 pub mod one_point;
+pub mod physical;
 
 use material::real::{Mask, Real};
 use material::tensor::M3;
@@ -49,6 +50,13 @@ pub enum HourglassForm {
     /// Stiffness (Flanagan-Belytschko, LS-DYNA type 4-5 style):
     /// f = -a_s gamma (gamma . u), a_s = Q (lambda + 2 mu)_0 sum_ia (V b_ia)^2 / (3 V) / 64.
     Stiffness,
+    /// Physical (assumed-strain) stabilisation in the spirit of Belytschko and Bindeman (1993,
+    /// LS-DYNA type 6): the hourglass modes carry the energy of the bending, twisting and
+    /// warping strain fields they stand for, with Young's and the shear modulus, so one element
+    /// through a thickness bends like beam theory and a nearly incompressible solid does not
+    /// lock. Q = 1 is the exact stiffness of a rectangular elastic element. See
+    /// [`physical`].
+    Physical,
 }
 
 /// Which modulus scales the hourglass resistance.
@@ -78,7 +86,8 @@ pub struct Hourglass {
     pub form: HourglassForm,
     /// Coefficient Q (LS-DYNA QH, default 0.1).
     pub coefficient: f64,
-    /// Modulus that scales the resistance.
+    /// Modulus that scales the resistance (the viscous and stiffness forms; the physical form
+    /// uses the law's Young's and shear moduli).
     pub modulus: HourglassModulus,
 }
 
@@ -118,15 +127,15 @@ impl Formulation {
         match self {
             Formulation::OnePoint(h) => format!(
                 "one-point, {}{} hourglass Q={}",
-                if h.modulus == HourglassModulus::Shear {
+                if h.modulus == HourglassModulus::Shear && h.form != HourglassForm::Physical {
                     "shear-scaled "
                 } else {
                     ""
                 },
-                if h.form == HourglassForm::Viscous {
-                    "viscous"
-                } else {
-                    "stiffness"
+                match h.form {
+                    HourglassForm::Viscous => "viscous",
+                    HourglassForm::Stiffness => "stiffness",
+                    HourglassForm::Physical => "physical (assumed-strain)",
                 },
                 h.coefficient
             ),

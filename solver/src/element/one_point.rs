@@ -4,12 +4,13 @@
 //! Hourglass generalised displacements and velocities: q_ialpha = sum_a u_ia gamma_alpha,a and
 //! qdot_ialpha = sum_a v_ia gamma_alpha,a (FB 1981 eq. 32).
 
+use super::physical::{self, PhysicalRef};
 use super::{
     add_nodal_forces, all_finite, bulk_pressure, critical_step, deformation_gradient, dot8,
     gradient_rate, max_face_area, sym6, ElementOut, HourglassForm, Nodal, StepInput, FAULT_FORCE,
 };
 use material::real::Real;
-use material::tensor::{cofactor, ddot, det, mul, mul_bt, scale};
+use material::tensor::{cofactor, ddot, det, mul, mul_bt, scale, M3};
 use material::Law;
 
 /// Reference data of one one-point element (or of one batch, one element per lane).
@@ -21,8 +22,10 @@ pub struct OnePointRef<'a, R: Real = f64> {
     /// Reference volume (m^3).
     pub vol0: R,
     /// Hourglass scale: a_s (N/m) for the stiffness form; Q rho0 V0^(2/3) / 4 (kg/m) for the
-    /// viscous form, to be multiplied by the wave speed.
+    /// viscous form, to be multiplied by the wave speed; Q V0 / 3 (m^3) for the physical form.
     pub hg_scale: R,
+    /// The element frame of the physical form (`None` for the other forms).
+    pub physical: Option<PhysicalRef<'a, R>>,
 }
 
 /// Internal forces of one element, or of a batch of elements (one per lane). `x` current
@@ -77,9 +80,16 @@ pub fn compute_forces<R: Real, L: Law>(
     *fe = [[R::zero(); 8]; 3];
     add_nodal_forces(fe, &p, r.grad, r.vol0);
     // Hourglass: generalised displacements (stiffness) or velocities (viscous) per mode.
-    let (a, w) = match hg_form {
-        HourglassForm::Viscous => (r.hg_scale * sqrt_scale * c, v),
-        HourglassForm::Stiffness => (r.hg_scale, u),
+    let (a, w) = match (hg_form, r.physical.as_ref()) {
+        (HourglassForm::Viscous, _) => (r.hg_scale * sqrt_scale * c, v),
+        (HourglassForm::Stiffness, _) => (r.hg_scale, u),
+        (HourglassForm::Physical, Some(ph)) => {
+            out.hourglass_stored = physical::add_forces(ph, r.hg_scale, &f, u, r.gamma, r.grad, fe);
+            return finish(out, &f, &resp.pk2, j, q, input, fe);
+        }
+        (HourglassForm::Physical, None) => {
+            unreachable!("a physical hourglass group is built with its element frames")
+        }
     };
     let mut qq = [[R::zero(); 4]; 3];
     let mut sumsq = R::zero();
@@ -98,12 +108,27 @@ pub fn compute_forces<R: Real, L: Law>(
                 + qq[i][3] * r.gamma[3][b];
         }
     }
-    match hg_form {
-        HourglassForm::Viscous => out.hourglass_power = a * sumsq,
-        HourglassForm::Stiffness => out.hourglass_stored = a * sumsq * 0.5,
+    if hg_form == HourglassForm::Viscous {
+        out.hourglass_power = a * sumsq;
+    } else {
+        out.hourglass_stored = a * sumsq * 0.5;
     }
+    finish(out, &f, &resp.pk2, j, q, input, fe)
+}
+
+/// The element's Cauchy stress (if asked for) and its fault check, once its forces are summed.
+#[inline(always)]
+fn finish<R: Real>(
+    mut out: ElementOut<R>,
+    f: &M3<R>,
+    pk2: &M3<R>,
+    j: R,
+    q: R,
+    input: &StepInput,
+    fe: &Nodal<R>,
+) -> ElementOut<R> {
     if input.want_stress {
-        let mut sigma = scale(&mul_bt(&mul(&f, &resp.pk2), &f), R::splat(1.0) / j);
+        let mut sigma = scale(&mul_bt(&mul(f, pk2), f), R::splat(1.0) / j);
         for i in 0..3 {
             sigma[i][i] -= q;
         }

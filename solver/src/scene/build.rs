@@ -1,7 +1,7 @@
 //! Build a [`Scene`] (model, simulation, output plan) from a [`SceneSpec`].
 
 use super::contact_spec::HandScene;
-use super::def::{DtMin, HourglassGuard, PartDef, SceneDef, Setup};
+use super::def::{BulkChange, DtMin, HourglassGuard, PartDef, SceneDef, Setup};
 use super::spec::*;
 use crate::bc::{Constraint, Kinematic, NodalLoad};
 use crate::curve::Curve;
@@ -283,20 +283,74 @@ fn mesh_units(spec: &MeshSpec, file: &Path) -> Result<f64, String> {
     }
 }
 
+/// The incompressibility knob of a part (`max_bulk_ratio` or `bulk_modulus`): the law and its
+/// card with the bulk modulus that runs, and the change to state.
+fn bulk_knob(
+    p: &PartSpec,
+    material: Material,
+    card: material::MaterialSpec,
+) -> Result<(Material, material::MaterialSpec, Option<BulkChange>), String> {
+    let k0 = material.bulk_modulus();
+    let g0 = material.initial_shear_modulus();
+    let (setting, k) = match (p.max_bulk_ratio, p.bulk_modulus) {
+        (None, None) => return Ok((material, card, None)),
+        (Some(_), Some(_)) => {
+            return Err("give max_bulk_ratio or bulk_modulus, not both".into());
+        }
+        (Some(r), None) => {
+            let r = r.0;
+            if !(r.is_finite() && r > 2.0 / 3.0) {
+                return Err(format!(
+                    "max_bulk_ratio must be a finite K/G above 2/3 (Poisson ratio above 0), got {r}"
+                ));
+            }
+            (format!("max_bulk_ratio = {r}"), k0.min(r * g0))
+        }
+        (None, Some(k)) => (format!("bulk_modulus = {:e} Pa", k.0), k.0),
+    };
+    let c0 = material.initial_wave_speed();
+    let m = if k == k0 {
+        material
+    } else {
+        material
+            .with_bulk_modulus(k)
+            .map_err(|e| format!("{setting}: {e}"))?
+    };
+    let change = BulkChange {
+        part: p.name.clone(),
+        setting,
+        original_pa: k0,
+        applied_pa: k,
+        shear_pa: g0,
+        wave_speed_m_s: [c0, m.initial_wave_speed()],
+    };
+    let card = if k == k0 { card } else { card.with_bulk_modulus(k, g0) };
+    Ok((m, card, Some(change)))
+}
+
 fn formulation(p: &PartSpec) -> Result<Formulation, String> {
-    let q = p.hourglass_coefficient.map(|x| x.0).unwrap_or(0.1);
-    if !(0.0..=1.0).contains(&q) {
-        return Err(format!("hourglass_coefficient must lie in [0, 1], got {q}"));
-    }
     let form = match p.hourglass.as_deref() {
         None | Some("viscous") => HourglassForm::Viscous,
         Some("stiffness") => HourglassForm::Stiffness,
+        Some("physical") => HourglassForm::Physical,
         Some(o) => {
             return Err(format!(
-                "hourglass must be `viscous` or `stiffness`, got `{o}`"
+                "hourglass must be `viscous`, `stiffness` or `physical`, got `{o}`"
             ))
         }
     };
+    // The physical form's coefficient scales an energy that is exact at 1.
+    let default_q = if form == HourglassForm::Physical { 1.0 } else { 0.1 };
+    let q = p.hourglass_coefficient.map(|x| x.0).unwrap_or(default_q);
+    if !(0.0..=1.0).contains(&q) {
+        return Err(format!("hourglass_coefficient must lie in [0, 1], got {q}"));
+    }
+    if form == HourglassForm::Physical && p.hourglass_modulus.is_some() {
+        return Err(
+            "hourglass_modulus does not apply to `physical` hourglass control (it uses Young's and the shear modulus of the law)"
+                .into(),
+        );
+    }
     let modulus = match p.hourglass_modulus.as_deref() {
         None | Some("p_wave") => HourglassModulus::PWave,
         Some("shear") => HourglassModulus::Shear,
@@ -504,11 +558,17 @@ pub fn resolve_scene(
             None => material::library::named(&ps.material)
                 .map_err(|m| e(&format!("{key}.material"), Some(&ps.material), &m))?,
         };
+        let (material, card, bulk) = bulk_knob(ps, material, card)
+            .map_err(|m| e(&key, Some(&format!("\"{pname}\"")), &m))?;
+        if let Some(b) = &bulk {
+            notes.push(b.describe());
+        }
         parts.push(PartDef {
             name: pname.clone(),
             material,
             spec: card,
             formulation,
+            bulk,
         });
     }
     for ps in &spec.parts {

@@ -129,6 +129,11 @@ pub struct PartSpec {
     /// Modulus scaling the hourglass control: `p_wave` (default, lambda + 2 mu as LS-DYNA
     /// types 1-5) or `shear` (2 mu, for nearly incompressible tissue).
     pub hourglass_modulus: Option<String>,
+    /// The incompressibility knob: cap the law's bulk modulus at this multiple of its initial
+    /// shear modulus (K <= ratio G0). Stated in the summary; the wave speed and step follow.
+    pub max_bulk_ratio: Option<Number>,
+    /// Or: replace the law's bulk modulus by this value.
+    pub bulk_modulus: Option<material::quantity::Pressure>,
 }
 
 /// `[node_sets.NAME]`.

@@ -26,6 +26,12 @@ pub const ONE_POINT_VISCOUS_SHEAR: Formulation = Formulation::OnePoint(Hourglass
     coefficient: 0.1,
     modulus: HourglassModulus::Shear,
 });
+/// One-point integration, physical (assumed-strain) hourglass stabilisation, Q = 1.
+pub const ONE_POINT_PHYSICAL: Formulation = Formulation::OnePoint(Hourglass {
+    form: HourglassForm::Physical,
+    coefficient: 1.0,
+    modulus: HourglassModulus::Shear,
+});
 /// Fully integrated 2x2x2 with F-bar.
 pub const FULL_FBAR: Formulation = Formulation::Full { fbar: true };
 /// Fully integrated 2x2x2, plain (standard Q1).
@@ -35,6 +41,7 @@ pub const FULL: Formulation = Formulation::Full { fbar: false };
 pub fn short(f: &Formulation) -> &'static str {
     match f {
         Formulation::OnePoint(h) if h.form == HourglassForm::Viscous => "1-pt viscous HG",
+        Formulation::OnePoint(h) if h.form == HourglassForm::Physical => "1-pt physical HG",
         Formulation::OnePoint(_) => "1-pt stiffness HG",
         Formulation::Full { fbar: true } => "full F-bar",
         Formulation::Full { fbar: false } => "full Q1",

@@ -8,7 +8,7 @@
 //! max |R_ref|), tolerance 1e-8, for the one-point (viscous and stiffness hourglass) and the
 //! fully integrated (F-bar and plain) formulations.
 
-use super::{short, FULL, FULL_FBAR, ONE_POINT_STIFFNESS, ONE_POINT_VISCOUS};
+use super::{short, FULL, FULL_FBAR, ONE_POINT_PHYSICAL, ONE_POINT_STIFFNESS, ONE_POINT_VISCOUS};
 use crate::data::{self, f, mesh, vec3, vec_u32};
 use crate::quasi::{max_abs, model, prescribe_node, relax};
 use crate::{CaseOutput, Row};
@@ -89,7 +89,13 @@ pub fn run() -> CaseOutput {
         ("scikit-fem", data::PATCH_SKFEM),
         ("FEniCSx", data::PATCH_FENICSX),
     ] {
-        for form in [ONE_POINT_VISCOUS, ONE_POINT_STIFFNESS, FULL_FBAR, FULL] {
+        for form in [
+            ONE_POINT_VISCOUS,
+            ONE_POINT_STIFFNESS,
+            ONE_POINT_PHYSICAL,
+            FULL_FBAR,
+            FULL,
+        ] {
             let case = format!("patch test, {}", short(&form));
             let src = format!("{reference} Q1 (distorted 3x3x3)");
             match patch_errors(text, form) {
