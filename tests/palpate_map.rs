@@ -63,3 +63,49 @@ fn palpate_draws_the_stress_picture() {
         "the largest stress's colour {want:?} covers {hot} pixels"
     );
 }
+
+/// `--fidelity fast` runs the physical hourglass form with the flesh's K/G capped at 5000: the
+/// summary states the preset with its error budget and the bulk moduli that ran
+/// (`summary.json`: the flesh's K = 5000 G, the ribs' cap not binding).
+#[test]
+fn the_fast_preset_states_itself_and_the_bulk_moduli_it_ran() {
+    let dir = tempfile::tempdir().unwrap();
+    let out = dir.path().join("f");
+    let o = Command::new(env!("CARGO_BIN_EXE_palpa"))
+        .args([
+            "palpate",
+            "--fidelity",
+            "fast",
+            "--voxel",
+            "8mm",
+            "--duration",
+            "2ms",
+            "--depth",
+            "2mm",
+            "--sample-interval",
+            "1ms",
+            "--no-vtk",
+            "--quiet",
+            "--out",
+        ])
+        .arg(&out)
+        .output()
+        .unwrap();
+    let text = String::from_utf8_lossy(&o.stdout);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(o.status.success(), "{text}{err}");
+    assert!(text.contains("fidelity: fast") && text.contains("ROI stress Fit"), "{text}");
+    let scene = std::fs::read_to_string(out.join("scene.toml")).unwrap();
+    assert!(scene.contains("hourglass = \"physical\""), "{scene}");
+    let s: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    let bulk = s["bulk_modulus"].as_array().unwrap();
+    let flesh = bulk.iter().find(|b| b["part"] == "flesh").unwrap();
+    let (k, g) = (
+        flesh["applied_pa"].as_f64().unwrap(),
+        flesh["shear_pa"].as_f64().unwrap(),
+    );
+    assert!((k / g - 5000.0).abs() < 1e-6, "K/G = {}", k / g);
+    let ribs = bulk.iter().find(|b| b["part"] == "ribs").unwrap();
+    assert_eq!(ribs["applied_pa"], ribs["original_pa"]);
+}

@@ -52,6 +52,8 @@
 //! dt_factor = 0.9
 //! mass_scaling = "initial"         # selective mass scaling: initial (default) | "2 x initial" | "4 us" | "off"
 //! # mass_scaling_limit = 0.05
+//! # fidelity = "fast"             # 1pt-physical elements and K/G <= 5000 (docs/palpate.md)
+//! # max_bulk_ratio = 5000           # or the K/G cap alone
 //! vtk = false                      # VTK frames of every run (off: only the probe files)
 //! ```
 //!
@@ -238,6 +240,12 @@ pub struct SolverSpec {
     pub mass_scaling_limit: Option<Number>,
     /// Write VTK frames of every run (default false).
     pub vtk: Option<bool>,
+    /// Preset of the accuracy knobs: `standard` (default) or `fast` (1pt-physical elements,
+    /// K/G capped at 5000; not with `element`, `element_by_part` or `max_bulk_ratio`).
+    pub fidelity: Option<String>,
+    /// The incompressibility knob: cap every part's bulk modulus at this multiple of its
+    /// shear modulus (as `palpate --max-bulk-ratio`).
+    pub max_bulk_ratio: Option<Number>,
 }
 
 /// Training or test location.
@@ -489,6 +497,19 @@ impl CampaignSpec {
                 .parse::<ElementChoice>()
                 .map_err(|m| format!("solver.element_by_part.{part}: {m}"))?;
             base.part_elements.insert(part.clone(), choice);
+        }
+        base.max_bulk_ratio = sv.max_bulk_ratio.map(|r| r.0);
+        if let Some(f) = &sv.fidelity {
+            let fid = f
+                .parse::<crate::palpation::Fidelity>()
+                .map_err(|e| format!("solver.fidelity: {e}"))?;
+            if fid == crate::palpation::Fidelity::Fast
+                && (sv.element.is_some() || sv.element_by_part.is_some() || sv.max_bulk_ratio.is_some())
+            {
+                return Err("solver.fidelity = \"fast\" sets the element and max_bulk_ratio: give the preset or those keys".into());
+            }
+            fid.apply(&mut base);
+            base.fidelity = fid;
         }
         if let Some(f) = sv.dt_factor {
             base.dt_factor = f.0;
@@ -1039,6 +1060,22 @@ mod tests {
         bad["torso_m"] = serde_json::json!([0.3, 0.2]);
         let e = phantom_params_from_json(&bad, None).unwrap_err();
         assert!(e.contains("torso_m"), "{e}");
+    }
+
+    #[test]
+    fn the_fast_fidelity_sets_the_element_and_the_cap_and_refuses_either_beside_it() {
+        let spec: CampaignSpec = toml::from_str("[solver]\nfidelity = \"fast\"\n").unwrap();
+        let c = spec.resolve().unwrap();
+        assert_eq!(c.base.element, ElementChoice::OnePointPhysical);
+        assert_eq!(c.base.max_bulk_ratio, Some(5000.0));
+        let scene = c.base.scene_toml();
+        assert!(scene.contains("max_bulk_ratio = 5000.0"), "{scene}");
+        for extra in ["element = \"full_fbar\"", "max_bulk_ratio = 100"] {
+            let spec: CampaignSpec =
+                toml::from_str(&format!("[solver]\nfidelity = \"fast\"\n{extra}\n")).unwrap();
+            let e = spec.resolve().unwrap_err();
+            assert!(e.contains("solver.fidelity"), "{e}");
+        }
     }
 
     #[test]

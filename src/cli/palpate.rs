@@ -14,7 +14,9 @@ use super::run::{print_summary, run_loaded};
 use super::units;
 use solver::output::atomic::write_atomic;
 use solver::output::history::{column, read_history};
-use solver::palpation::{read_probe, ElementChoice, PalpationSetup, Place, ProbeSamples};
+use solver::palpation::{
+    read_probe, ElementChoice, Fidelity, PalpationSetup, Place, ProbeSamples,
+};
 use solver::scene::load_scene;
 use std::fmt::Write;
 use std::path::Path;
@@ -55,12 +57,12 @@ pub struct PalpateArgs {
     /// Respiratory phase, 0 (exhalation) .. 1 (inspiration).
     #[arg(long, default_value_t = 0.0)]
     pub phase: f64,
-    /// Element formulation: one_point (= 1pt-viscous-shear: one-point, viscous hourglass
+    /// Element formulation [default: one_point]: one_point (= 1pt-viscous-shear: one-point, viscous hourglass
     /// control scaled by the shear modulus), 1pt-viscous or 1pt-stiffness (hourglass scaled by
     /// the P-wave modulus, LS-DYNA types 1 and 4), 1pt-stiffness-shear, 1pt-physical
     /// (assumed-strain stabilisation, in the spirit of LS-DYNA type 6), or full_fbar.
-    #[arg(long, default_value = "one_point")]
-    pub element: String,
+    #[arg(long)]
+    pub element: Option<String>,
     /// Selective mass scaling: `initial` (default: an element gets mass only when it shrinks
     /// below the initial stable step, so the step never falls; the added mass is reported),
     /// `K x initial`, a time step such as `4us`, or `off`.
@@ -74,6 +76,11 @@ pub struct PalpateArgs {
     /// the stable step, follow; the summary states the change. Default: the laws' own.
     #[arg(long)]
     pub max_bulk_ratio: Option<f64>,
+    /// Preset of the accuracy knobs: `standard` (the options as given) or `fast`
+    /// (1pt-physical elements and K/G capped at 5000: about a third of the steps; its measured
+    /// error against F-bar elements is printed with the summary and in docs/palpate.md).
+    #[arg(long, default_value = "standard")]
+    pub fidelity: String,
     /// Skip the VTK frames.
     #[arg(long)]
     pub no_vtk: bool,
@@ -120,12 +127,26 @@ impl PalpateArgs {
         s.respiratory_phase = self.phase;
         s.element = self
             .element
+            .as_deref()
+            .unwrap_or("one_point")
             .parse::<ElementChoice>()
             .map_err(|e| format!("--element: {e}"))?;
         s.mass_scaling = solver::model::StepTarget::parse_switch(&self.mass_scaling)
             .map_err(|e| format!("--mass-scaling: {e}"))?;
         s.dt_factor = self.dt_factor;
         s.max_bulk_ratio = self.max_bulk_ratio;
+        let fidelity = self
+            .fidelity
+            .parse::<Fidelity>()
+            .map_err(|e| format!("--fidelity: {e}"))?;
+        if fidelity == Fidelity::Fast && (self.element.is_some() || self.max_bulk_ratio.is_some()) {
+            return Err(
+                "--fidelity fast sets --element and --max-bulk-ratio: give the preset or the options"
+                    .into(),
+            );
+        }
+        fidelity.apply(&mut s);
+        s.fidelity = fidelity;
         s.vtk = !self.no_vtk;
         s.title = match &s.place {
             Place::Named(n) => format!("palpation at {n}"),
@@ -188,6 +209,7 @@ pub fn palpate(args: &PalpateArgs) -> Result<(), String> {
     }
     let (summary, err) = run_loaded(&mut scene, out, args.quiet);
     print_summary(&summary);
+    println!("  fidelity: {}", setup.fidelity.describe());
     // Post-processing also for a failed run: what was written stays usable.
     let picture = MapSetup {
         view: &view,
