@@ -80,6 +80,9 @@ pub struct RunSummary {
     pub mass: Vec<PartMassReport>,
     /// Parts whose bulk modulus the scene changed (the incompressibility knob).
     pub bulk_modulus: Vec<crate::scene::def::BulkChange>,
+    /// What the user should look at although the run finished (e.g. the hourglass energy
+    /// above [`HOURGLASS_WARNING`] of the internal energy).
+    pub warnings: Vec<String>,
     /// Threads used.
     pub threads: usize,
     /// Frames written.
@@ -100,6 +103,23 @@ impl RunSummary {
             .fold((0.0, 0.0), |(p, a), m| (p + m.physical_kg, a + m.added_kg));
         100.0 * a / p.max(1e-300)
     }
+}
+
+/// The hourglass energy, as a fraction of the internal energy, above which the summary warns
+/// (LS-DYNA users' rule of thumb: 10 %).
+pub const HOURGLASS_WARNING: f64 = 0.1;
+
+/// The summary's warnings for final energies.
+pub fn energy_warnings(internal: f64, hourglass: f64) -> Vec<String> {
+    let mut w = Vec::new();
+    if internal > 0.0 && hourglass > HOURGLASS_WARNING * internal {
+        w.push(format!(
+            "the hourglass energy is {:.1} % of the internal energy (above {:.0} %): the one-point elements deform in modes their mean strain does not see; try hourglass = \"physical\" (or --element 1pt-physical), a finer mesh or F-bar elements, and stop such runs with [run] max_hourglass_ratio",
+            100.0 * hourglass / internal,
+            100.0 * HOURGLASS_WARNING
+        ));
+    }
+    w
 }
 
 /// An eroded element, for the summary.
@@ -490,6 +510,7 @@ pub fn run_scene(
             })
             .collect(),
         bulk_modulus: scene.setup.parts.iter().filter_map(|p| p.bulk.clone()).collect(),
+        warnings: energy_warnings(e.internal, e.hourglass),
         threads: rayon::current_num_threads(),
         frames: series.len(),
         eroded_elements: sim.erosion.count,
@@ -507,4 +528,18 @@ pub fn run_scene(
         }
     }
     (summary, error)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn hourglass_energy_above_a_tenth_of_the_internal_energy_is_warned_about() {
+        assert!(energy_warnings(1.0, 0.1).is_empty());
+        let w = energy_warnings(1.0, 0.24);
+        assert_eq!(w.len(), 1);
+        assert!(w[0].contains("24.0 %") && w[0].contains("physical"), "{}", w[0]);
+        assert!(energy_warnings(0.0, 0.5).is_empty());
+    }
 }

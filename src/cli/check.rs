@@ -76,15 +76,32 @@ pub fn check(path: &Path, deck: &DeckArgs) -> Result<(), String> {
             100.0 * m.added_mass() / m.physical_mass(),
             m.physical_mass()
         );
+    } else if let Some(ms) = &m.mass_scaling {
+        println!(
+            "  mass scaling: target step {:.4e} s; no element is below it at the start (the run adds mass to elements whose step falls below it, up to {:.3} % of the physical mass)",
+            ms.target_dt,
+            100.0 * ms.max_added
+        );
     } else {
         println!("  mass scaling: none");
     }
-    let steps = scene.end_time / (f * m.scaled_dt.min(dt0).max(m.scaled_dt));
+    let dt_max = sim.settings.dt_max;
+    let steps = solver::scene::def::estimated_steps(
+        m,
+        f,
+        dt_max.is_finite().then_some(dt_max),
+        scene.end_time,
+    );
     println!(
-        "  estimated steps: {:.0} ({:.3e} element-cycles) for end time {:.4} ms",
+        "  estimated steps: {:.0} ({:.3e} element-cycles) for end time {:.4} ms{} (at the starting step; elements that shrink under load lower it, so a run may take more)",
         steps,
         steps * mesh.elements.len() as f64,
-        scene.end_time * 1e3
+        scene.end_time * 1e3,
+        if dt_max.is_finite() && dt_max < f * dt0 {
+            format!(", the step capped by dt_max = {dt_max:.4e} s")
+        } else {
+            String::new()
+        }
     );
     let hist: usize = m.groups.iter().map(|g| g.history.len() * 8).sum();
     let ref_data: usize = m

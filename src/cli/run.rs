@@ -51,6 +51,9 @@ pub fn print_summary(s: &RunSummary) {
     for b in &s.bulk_modulus {
         println!("  bulk modulus: {}", b.describe());
     }
+    for w in &s.warnings {
+        println!("  warning: {w}");
+    }
     if let Some(e) = &s.first_eroded {
         println!(
             "  eroded elements: {} (the first, element {} of part `{}`, at {:.4} ms)",
