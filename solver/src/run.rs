@@ -259,8 +259,16 @@ fn check_stability(sim: &Simulation) -> Result<(), String> {
     let scale = all.iter().fold(0.0f64, |m, x| m.max(x.abs()));
     if e.internal < -0.05 * scale && scale > 0.0 {
         let el = sim.dt_element;
+        // The advice follows the dissipation that outran the work: bulk viscosity booked from
+        // each element's rate at the start of the step overshoots when a prescribed motion
+        // starts abruptly on nearly incompressible material.
+        let advice = if e.bulk_viscous >= e.hourglass {
+            "the bulk-viscous dissipation outran the work it absorbs, as when a prescribed motion starts abruptly: ramp the motion (kind = \"smooth_step\"), lower `run.dt_factor`, or lower the bulk viscosity"
+        } else {
+            "the hourglass dissipation outran the work it absorbs: lower `run.dt_factor`, or use stiffness or physical hourglass control"
+        };
         return Err(format!(
-            "numerical instability at t = {:.6} ms: the internal energy became negative ({:.4e} J; hourglass {:.4e} J, bulk viscosity {:.4e} J, external work {:.4e} J). The step was set by element {el} (part {}); lower `run.dt_factor` (now {}) or use stiffness hourglass control",
+            "numerical instability at t = {:.6} ms: the internal energy became negative ({:.4e} J; hourglass {:.4e} J, bulk viscosity {:.4e} J, external work {:.4e} J). The step was set by element {el} (part {}), `run.dt_factor` {}; {advice}",
             sim.time * 1e3,
             e.internal,
             e.hourglass,
