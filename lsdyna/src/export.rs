@@ -737,7 +737,7 @@ pub fn export(scene: &Scene, opts: &ExportOptions) -> Result<Exported, String> {
                 };
                 if h.form == HourglassForm::Physical {
                     notes.push(format!(
-                        "part `{}`: physical hourglass control Q = {} written as LS-DYNA type 6 (Belytschko-Bindeman assumed strain, co-rotational rate form; palpa's is total Lagrangian, the two agree to first order)",
+                        "part `{}`: physical hourglass control Q = {} written as LS-DYNA type 6 (Belytschko-Bindeman assumed strain, a co-rotational rate form; palpa's acts on the Green strain of the modes: they agree at small strain)",
                         p.name, h.coefficient
                     ));
                 } else if h.modulus == HourglassModulus::Shear {
@@ -801,6 +801,12 @@ pub fn export(scene: &Scene, opts: &ExportOptions) -> Result<Exported, String> {
             w.kw("HOURGLASS");
             let cells = [w.int(pid, 10), w.int(ihq, 10), w.num(qm, 10)];
             w.card(&cells);
+        }
+        if let Some(b) = p.bulk.as_ref().filter(|b| b.applied_pa != b.original_pa) {
+            notes.push(format!(
+                "part `{}`: the card carries the bulk modulus that ran, {:e} Pa, set by `{}` (the law's own is {:e} Pa)",
+                p.name, b.applied_pa, b.setting, b.original_pa
+            ));
         }
         write_material(&mut w, pid, p, &mut notes, &mut new_curve)?;
     }

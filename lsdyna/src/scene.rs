@@ -1484,16 +1484,16 @@ fn element(cx: &mut Ctx, p: &PartInfo, material: &Material) -> Result<Formulatio
             let form = match ihq {
                 1..=3 => HourglassForm::Viscous,
                 4 | 5 => HourglassForm::Stiffness,
-                6 => HourglassForm::Physical,
+                6 | 7 => HourglassForm::Physical,
                 o => {
                     return Err(format!(
-                        "{hg_at}: hourglass type IHQ = {o} is not supported (palpa: 1-3 viscous, 4-5 stiffness, Flanagan-Belytschko, scaled by the P-wave modulus; 6 physical, assumed strain)"
+                        "{hg_at}: hourglass type IHQ = {o} is not supported (palpa: 1-3 viscous, 4-5 stiffness, Flanagan-Belytschko, scaled by the P-wave modulus; 6-7 physical, assumed strain)"
                     ))
                 }
             };
             if form == HourglassForm::Physical {
                 cx.warn.push(format!(
-                    "{hg_at}: IHQ = 6 read as palpa's physical hourglass form with QM = {qm} as its coefficient (Belytschko-Bindeman assumed strain in total Lagrangian form; LS-DYNA integrates type 6 in co-rotational rate form, the two agree to first order)"
+                    "{hg_at}: IHQ = {ihq} read as palpa's physical hourglass form with QM = {qm} as its coefficient (Belytschko-Bindeman assumed strain on the Green strain of the modes; LS-DYNA's type 6 is a co-rotational rate form, type 7 a total-strain one: they agree at small strain)"
                 ));
             }
             if !(0.0..=1.0).contains(&qm) {

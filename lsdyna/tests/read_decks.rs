@@ -353,7 +353,7 @@ punch
 }
 
 #[test]
-fn hourglass_type_6_reads_as_the_physical_form_and_7_is_refused() {
+fn hourglass_types_6_and_7_read_as_the_physical_form_and_8_is_refused() {
     use solver::element::{Formulation, HourglassForm};
     let dir = tempfile::tempdir().unwrap();
     let p = write(
@@ -376,6 +376,16 @@ fn hourglass_type_6_reads_as_the_physical_form_and_7_is_refused() {
         "ihq7.k",
         &prepost_deck("*CONTROL_HOURGLASS\n         7       1.0\n"),
     );
+    let (def, _) = read_deck(&p, &kg_mm_ms()).unwrap();
+    assert!(matches!(
+        def.setup.parts[0].formulation,
+        Formulation::OnePoint(h) if h.form == HourglassForm::Physical
+    ));
+    let p = write(
+        dir.path(),
+        "ihq8.k",
+        &prepost_deck("*CONTROL_HOURGLASS\n         8       1.0\n"),
+    );
     let e = fails(&p, &kg_mm_ms()).to_string();
-    assert!(e.contains("IHQ = 7") && e.contains("ihq7.k"), "{e}");
+    assert!(e.contains("IHQ = 8") && e.contains("ihq8.k"), "{e}");
 }

@@ -783,6 +783,10 @@ impl Campaign {
                 .collect::<serde_json::Map<_, _>>()
                 .into();
         }
+        // The incompressibility knob changes every run's physics: part of the identity.
+        if let Some(r) = b.max_bulk_ratio {
+            plan["settings"]["max_bulk_ratio"] = json!(r);
+        }
         plan
     }
 }
@@ -1183,6 +1187,11 @@ mod tests {
         assert_eq!(plan["settings"]["element_by_part"]["liver"], "full-fbar");
         let plain = Campaign::paper().plan_json(&ph, &[]);
         assert!(plain["settings"].get("element_by_part").is_none());
+        assert!(plain["settings"].get("max_bulk_ratio").is_none());
+        let fast: CampaignSpec = toml::from_str("[solver]\nfidelity = \"fast\"\n").unwrap();
+        let fast = fast.resolve().unwrap().plan_json(&ph, &[]);
+        assert_eq!(fast["settings"]["max_bulk_ratio"], 5000.0);
+        assert_eq!(fast["settings"]["element"], "1pt-physical");
     }
 
     #[test]

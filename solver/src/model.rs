@@ -550,7 +550,13 @@ impl Model {
             };
             if matches!(form, Formulation::OnePoint(h) if h.form == HourglassForm::Physical) {
                 let mu = law.initial_shear_modulus();
-                let (e, nu) = physical::young_poisson(lambda2mu, mu);
+                let (e, nu) = physical::young_poisson(lambda2mu, mu).ok_or_else(|| {
+                    SolverError::Invalid(format!(
+                        "part `{}`: physical hourglass control needs a positive shear and bulk modulus (its law has G = {mu:e} Pa, K = {:e} Pa)",
+                        part.name,
+                        lambda2mu - 4.0 * mu / 3.0
+                    ))
+                })?;
                 g.hg_moduli = [e, nu, mu];
             }
             for &e in &elems {
@@ -571,12 +577,10 @@ impl Model {
                         gamma.push(hourglass_gamma(&x, &geo.mean_grad));
                         if hg.form == HourglassForm::Physical {
                             frames.push(physical::element_frame(&x).ok_or_else(|| {
-                                SolverError::InvertedElement {
-                                    element: e,
-                                    part: part.name.clone(),
-                                    corner: 0,
-                                    det: 0.0,
-                                }
+                                SolverError::Invalid(format!(
+                                    "element {e} (part `{}`): no element frame for physical hourglass control (an edge of zero length)",
+                                    part.name
+                                ))
                             })?);
                             g.hg_scale.push(hg.coefficient * geo.volume / 3.0);
                         } else if hg.form == HourglassForm::Stiffness {

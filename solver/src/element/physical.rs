@@ -46,10 +46,15 @@
 //! rotation leaves it unchanged (objective), and the nodal forces are its exact gradient,
 //!   f_a = sum_alpha [ 1/8 gamma_alpha,a F Q~_alpha + (b_a . Q~_alpha) q_alpha ],
 //! with `Q~_alpha = R0 dW/dq^_alpha` and `b_a` the mean gradient; the second term comes from the
-//! dependence of `F` on the nodes. So the stored hourglass energy is exact, and it enters the
-//! energy balance like the stiffness form's. LS-DYNA's type 6 instead integrates the same
-//! stiffness in a co-rotational rate form; for the elastic laws and the strains of a palpation
-//! the two agree to first order.
+//! dependence of `F` on the nodes. The energy is the strain energy of the assumed field, so the
+//! element books it as internal energy (the work of its forces), not as hourglass energy: the
+//! hourglass guard and the summary's hourglass warning concern the spurious modes of the
+//! viscous and stiffness forms only. (LS-DYNA reports its type 6 energy as hourglass energy.)
+//!
+//! `F^T q` is a Green-strain (St Venant-Kirchhoff-like) measure: under a stretch `lambda` along
+//! an element axis the hourglass stiffness of the modes along it scales with `lambda^2`, about
+//! half the small-strain value at 30 % compression. LS-DYNA's type 6, a co-rotational rate
+//! form, does not scale so; the two agree at small strain only.
 //!
 //! **Limits.** The element frame and half-lengths make the energy exact for rectangular
 //! elements and an approximation for distorted ones (as in Belytschko and Bindeman). The
@@ -98,18 +103,16 @@ pub fn element_frame(x: &[[f64; 3]; 8]) -> Option<([[f64; 3]; 3], [f64; 3])> {
 }
 
 /// Young's modulus and Poisson's ratio from a P-wave modulus `m` and a shear modulus `mu`:
-/// `E = 9 K mu / (3 K + mu)`, `nu = (3 K - 2 mu) / (2 (3 K + mu))`, `K = m - 4 mu / 3`
-/// (`(0, 0)` for a degenerate pair).
-pub fn young_poisson(m: f64, mu: f64) -> (f64, f64) {
+/// `E = 9 K mu / (3 K + mu)`, `nu = (3 K - 2 mu) / (2 (3 K + mu))`, `K = m - 4 mu / 3`;
+/// `None` unless both K and mu are positive.
+pub fn young_poisson(m: f64, mu: f64) -> Option<(f64, f64)> {
     let k = m - 4.0 * mu / 3.0;
-    if k > 0.0 && mu > 0.0 {
+    (k > 0.0 && mu > 0.0).then(|| {
         (
             9.0 * k * mu / (3.0 * k + mu),
             (3.0 * k - 2.0 * mu) / (2.0 * (3.0 * k + mu)),
         )
-    } else {
-        (0.0, 0.0)
-    }
+    })
 }
 
 /// Adds the physical hourglass forces to `fe` and returns the stored hourglass energy (J).
@@ -347,5 +350,51 @@ mod tests {
         let (fe, w) = forces(&x, &u, 3.0e5, 1.0e5);
         assert!(w.abs() < 1e-20);
         assert!(fe.iter().flatten().all(|f| f.abs() < 1e-12));
+    }
+
+    /// The other two bending planes, the warp mode and torsion about z, each on an aligned and
+    /// on a rotated box (catches a transposed frame, a mis-paired bending couple or a wrong
+    /// warp coefficient, which the tests above cannot see).
+    #[test]
+    fn every_bending_plane_warp_and_torsion_about_z_on_aligned_and_rotated_boxes() {
+        let a = [0.02, 0.01, 0.005];
+        let (e, mu) = (2.6e5, 1.0e5);
+        let nu = e / (2.0 * mu) - 1.0;
+        let v = 8.0 * a[0] * a[1] * a[2];
+        let k = 1e-3;
+        for r in [Matrix3::identity(), rot(0.9)] {
+            let case = |field: &dyn Fn([f64; 3]) -> [f64; 3]| {
+                let x = box_corners(a, &r);
+                let u: [[f64; 3]; 8] = std::array::from_fn(|n| {
+                    let p = [a[0] * CORNERS[n][0], a[1] * CORNERS[n][1], a[2] * CORNERS[n][2]];
+                    let ul = field(p);
+                    let ug = r * nalgebra::Vector3::new(ul[0], ul[1], ul[2]);
+                    [ug[0], ug[1], ug[2]]
+                });
+                forces(&x, &u, e, mu).1
+            };
+            // Beam along y bent in x, with its contraction.
+            let w = case(&|p| [0.0, k * p[0] * p[1], -nu * k * p[0] * p[2]]);
+            let i = (2.0 * a[2]) * (2.0 * a[0]).powi(3) / 12.0;
+            let exact = 0.5 * e * i * k * k * 2.0 * a[1];
+            assert!((w - exact).abs() < 1e-6 * exact, "y-beam {w} {exact}");
+            // Beam along z bent in y, with its contraction.
+            let w = case(&|p| [-nu * k * p[1] * p[0], 0.0, k * p[1] * p[2]]);
+            let i = (2.0 * a[0]) * (2.0 * a[1]).powi(3) / 12.0;
+            let exact = 0.5 * e * i * k * k * 2.0 * a[2];
+            assert!((w - exact).abs() < 1e-6 * exact, "z-beam {w} {exact}");
+            // Warp in x: u_x = c x y z.
+            let c = 1e-2;
+            let w = case(&|p| [c * p[0] * p[1] * p[2], 0.0, 0.0]);
+            let q = c * a[0] * a[1] * a[2];
+            let exact = v / 18.0
+                * (e * (q / a[0]).powi(2) + mu * ((q / a[1]).powi(2) + (q / a[2]).powi(2)));
+            assert!((w - exact).abs() < 1e-6 * exact, "warp {w} {exact}");
+            // Torsion about z.
+            let th = 1e-3;
+            let w = case(&|p| [-th * p[2] * p[1], th * p[2] * p[0], 0.0]);
+            let exact = 0.5 * mu * th * th * (a[0] * a[0] + a[1] * a[1]) / 3.0 * v;
+            assert!((w - exact).abs() < 1e-6 * exact, "torsion z {w} {exact}");
+        }
     }
 }

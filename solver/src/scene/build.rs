@@ -308,6 +308,11 @@ fn bulk_knob(
         }
         (None, Some(k)) => (format!("bulk_modulus = {:e} Pa", k.0), k.0),
     };
+    if k != k0 && matches!(material, Material::PiecewiseLinearPlasticity(_)) {
+        return Err(format!(
+            "{setting} would change the bulk modulus of a piecewise_linear_plasticity law, whose hardening is given through its Young's modulus: change the card's youngs_modulus and poisson_ratio instead"
+        ));
+    }
     let c0 = material.initial_wave_speed();
     let m = if k == k0 {
         material
