@@ -1479,6 +1479,8 @@ fn element(cx: &mut Ctx, p: &PartInfo, material: &Material) -> Result<Formulatio
         .filter(|&q| q != 0.0)
         .unwrap_or(ctl_qh);
     let hg_at = hg.map_or(sec.at.to_string(), |h| h.at.to_string());
+    // Said only where the LS-DYNA element is used (not when palpa's own comment restores it).
+    let mut physical_note: Option<String> = None;
     let lsdyna = match sec.elform {
         0 | 1 => {
             let form = match ihq {
@@ -1492,7 +1494,7 @@ fn element(cx: &mut Ctx, p: &PartInfo, material: &Material) -> Result<Formulatio
                 }
             };
             if form == HourglassForm::Physical {
-                cx.warn.push(format!(
+                physical_note = Some(format!(
                     "{hg_at}: IHQ = {ihq} read as palpa's physical hourglass form with QM = {qm} as its coefficient (Belytschko-Bindeman assumed strain on the Green strain of the modes; LS-DYNA's type 6 is a co-rotational rate form, type 7 a total-strain one: they agree at small strain)"
                 ));
             }
@@ -1524,6 +1526,7 @@ fn element(cx: &mut Ctx, p: &PartInfo, material: &Material) -> Result<Formulatio
     let mut t = cx.comments(&p.card.palpa.clone());
     let Some(note) = annotate::take::<ElementNote>(&mut t, "element", &p.card.at, &mut cx.warn)
     else {
+        cx.warn.extend(physical_note);
         return Ok(lsdyna);
     };
     // The palpa element the comment names must be the LS-DYNA one, up to the hourglass scaling.
@@ -1568,6 +1571,7 @@ fn element(cx: &mut Ctx, p: &PartInfo, material: &Material) -> Result<Formulatio
                 "{}: `$palpa: element` does not match the part's ELFORM, IHQ and QM; the LS-DYNA element is used",
                 p.card.at
             ));
+            cx.warn.extend(physical_note);
             Ok(lsdyna)
         }
     }

@@ -155,6 +155,30 @@ fn palpation_round_trips_exactly() {
     same(&a, &b);
 }
 
+/// The fast preset (physical hourglass control, the flesh's K capped at 5000 G) reads back as
+/// the same laws and elements: the deck carries the capped K and IHQ 6 with palpa's comment,
+/// without a warning.
+#[test]
+fn the_fast_preset_round_trips_exactly() {
+    let dir = tempfile::tempdir().unwrap();
+    let mut setup = solver::palpation::PalpationSetup {
+        voxel: 0.008,
+        depth: 0.004,
+        duration: 0.004,
+        sample_interval: 0.001,
+        ..Default::default()
+    };
+    solver::palpation::Fidelity::Fast.apply(&mut setup);
+    let path = dir.path().join("scene.toml");
+    std::fs::write(&path, setup.scene_toml()).unwrap();
+    let a = load_scene(&path).unwrap();
+    let flesh = a.setup.parts.iter().find(|p| p.name == "flesh").unwrap();
+    let g = flesh.material.initial_shear_modulus();
+    assert!((flesh.material.bulk_modulus() / g - 5000.0).abs() < 1e-9);
+    let b = roundtrip(&a, "kg-mm-ms");
+    same(&a, &b);
+}
+
 /// Scenes that use what LS-DYNA has no keyword for: each reads back the same.
 #[test]
 fn every_scene_option_round_trips() {
