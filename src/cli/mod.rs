@@ -98,8 +98,9 @@ enum Command {
         #[arg(long, default_value = "verification-report")]
         out: PathBuf,
     },
-    /// Accuracy against cost: vary mesh size, element formulation, mass scaling and time-step
-    /// factor on the phantom palpation; write study.csv, study.md and Pareto plots into --out.
+    /// Accuracy against cost: vary mesh size, element formulation, mass scaling, the bulk
+    /// modulus cap and the time-step factor on the phantom palpation; write study.csv, study.md
+    /// and Pareto plots into --out.
     Study {
         /// The quick profile (coarse phantom, 6 mm in 6 ms): a few minutes on 2 cores.
         #[arg(long)]

@@ -3,8 +3,8 @@
 //! Every knob that trades accuracy for speed is measured both ways on the palpation of the
 //! abdomen phantom ([`solver::palpation`]): the mesh size (voxel edge), the element formulation,
 //! selective mass scaling (targets of 1, 2, 4 and 10 times the initial stable step; 1 is
-//! palpate's default, which adds mass only to elements that shrink during the run) and the time-step
-//! factor. Each setting changes one knob of a base setting (one-point elements with
+//! palpate's default, which adds mass only to elements that shrink during the run), the bulk
+//! modulus cap (K/G 5e3, 1e3, 5e2 against the laws' own 5e4) and the time-step factor. Each setting changes one knob of a base setting (one-point elements with
 //! shear-scaled viscous hourglass control, no mass scaling, time-step factor 0.9, the coarsest
 //! mesh) and is run to the end; the study records its wall time, its element-cycles (elements x
 //! steps) and two errors against the most accurate setting of the same knob (the finest mesh,
@@ -175,6 +175,19 @@ fn plan(quick: bool) -> Vec<Variant> {
             PalpationSetup {
                 mass_scaling: Some(StepTarget::Initial(k)),
                 mass_scaling_limit: 1e3,
+                ..base.clone()
+            },
+            false,
+        );
+    }
+    // The incompressibility knob: every part's K capped at ratio x G (the flesh's is 5e4).
+    push("bulk ratio", "laws' own (K/G 5e4)".into(), base.clone(), true);
+    for r in [5e3, 1e3, 5e2] {
+        push(
+            "bulk ratio",
+            format!("K/G <= {r}"),
+            PalpationSetup {
+                max_bulk_ratio: Some(r),
                 ..base.clone()
             },
             false,
