@@ -94,7 +94,10 @@ fn the_fast_preset_states_itself_and_the_bulk_moduli_it_ran() {
     let text = String::from_utf8_lossy(&o.stdout);
     let err = String::from_utf8_lossy(&o.stderr);
     assert!(o.status.success(), "{text}{err}");
-    assert!(text.contains("fidelity: fast") && text.contains("ROI stress Fit"), "{text}");
+    assert!(
+        text.contains("fidelity: fast") && text.contains("ROI stress Fit"),
+        "{text}"
+    );
     let scene = std::fs::read_to_string(out.join("scene.toml")).unwrap();
     assert!(scene.contains("hourglass = \"physical\""), "{scene}");
     let s: serde_json::Value =

@@ -1549,7 +1549,11 @@ fn element(cx: &mut Ctx, p: &PartInfo, material: &Material) -> Result<Formulatio
             };
             let q = note
                 .hourglass_coefficient
-                .unwrap_or(if form == HourglassForm::Physical { 1.0 } else { 0.1 });
+                .unwrap_or(if form == HourglassForm::Physical {
+                    1.0
+                } else {
+                    0.1
+                });
             let ratio = match (modulus, form) {
                 (_, HourglassForm::Physical) | (HourglassModulus::PWave, _) => 1.0,
                 (HourglassModulus::Shear, HourglassForm::Viscous) => (two_mu / lambda2mu).sqrt(),

@@ -101,7 +101,9 @@ impl Material {
     /// `bulk_modulus` under `[[part]]`). The wave speed, and so the stable step, follow it.
     pub fn with_bulk_modulus(&self, k: f64) -> Result<Material, String> {
         if !(k > 0.0 && k.is_finite()) {
-            return Err(format!("the bulk modulus must be positive and finite, got {k:e} Pa"));
+            return Err(format!(
+                "the bulk modulus must be positive and finite, got {k:e} Pa"
+            ));
         }
         let mut m = self.clone();
         match &mut m {

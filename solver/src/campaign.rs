@@ -504,7 +504,9 @@ impl CampaignSpec {
                 .parse::<crate::palpation::Fidelity>()
                 .map_err(|e| format!("solver.fidelity: {e}"))?;
             if fid == crate::palpation::Fidelity::Fast
-                && (sv.element.is_some() || sv.element_by_part.is_some() || sv.max_bulk_ratio.is_some())
+                && (sv.element.is_some()
+                    || sv.element_by_part.is_some()
+                    || sv.max_bulk_ratio.is_some())
             {
                 return Err("solver.fidelity = \"fast\" sets the element and max_bulk_ratio: give the preset or those keys".into());
             }

@@ -517,7 +517,12 @@ pub fn run_scene(
                 added_percent: 100.0 * p.added / p.physical.max(1e-300),
             })
             .collect(),
-        bulk_modulus: scene.setup.parts.iter().filter_map(|p| p.bulk.clone()).collect(),
+        bulk_modulus: scene
+            .setup
+            .parts
+            .iter()
+            .filter_map(|p| p.bulk.clone())
+            .collect(),
         warnings: energy_warnings(e.internal, e.hourglass),
         threads: rayon::current_num_threads(),
         frames: series.len(),
@@ -547,7 +552,11 @@ mod tests {
         assert!(energy_warnings(1.0, 0.1).is_empty());
         let w = energy_warnings(1.0, 0.24);
         assert_eq!(w.len(), 1);
-        assert!(w[0].contains("24.0 %") && w[0].contains("physical"), "{}", w[0]);
+        assert!(
+            w[0].contains("24.0 %") && w[0].contains("physical"),
+            "{}",
+            w[0]
+        );
         assert!(energy_warnings(0.0, 0.5).is_empty());
     }
 }

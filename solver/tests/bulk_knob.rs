@@ -75,7 +75,10 @@ fn a_binding_cap_sets_k_and_the_step_follows() {
         (ratio - expect).abs() < 1e-9 * expect,
         "step ratio {ratio}, expected {expect}"
     );
-    assert!(capped.notes.iter().any(|n| n.contains("max_bulk_ratio = 100")));
+    assert!(capped
+        .notes
+        .iter()
+        .any(|n| n.contains("max_bulk_ratio = 100")));
 }
 
 #[test]
@@ -113,10 +116,7 @@ fn a_stated_bulk_modulus_replaces_the_laws() {
 #[test]
 fn bad_knob_settings_are_refused_naming_the_part() {
     for (keys, needle) in [
-        (
-            "max_bulk_ratio = 10\nbulk_modulus = \"1 MPa\"",
-            "not both",
-        ),
+        ("max_bulk_ratio = 10\nbulk_modulus = \"1 MPa\"", "not both"),
         ("max_bulk_ratio = 0.5", "max_bulk_ratio"),
         ("bulk_modulus = \"-1 MPa\"", "bulk modulus"),
         (

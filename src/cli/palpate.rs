@@ -14,9 +14,7 @@ use super::run::{print_summary, run_loaded};
 use super::units;
 use solver::output::atomic::write_atomic;
 use solver::output::history::{column, read_history};
-use solver::palpation::{
-    read_probe, ElementChoice, Fidelity, PalpationSetup, Place, ProbeSamples,
-};
+use solver::palpation::{read_probe, ElementChoice, Fidelity, PalpationSetup, Place, ProbeSamples};
 use solver::scene::load_scene;
 use std::fmt::Write;
 use std::path::Path;

@@ -181,7 +181,12 @@ fn plan(quick: bool) -> Vec<Variant> {
         );
     }
     // The incompressibility knob: every part's K capped at ratio x G (the flesh's is 5e4).
-    push("bulk ratio", "laws' own (K/G 5e4)".into(), base.clone(), true);
+    push(
+        "bulk ratio",
+        "laws' own (K/G 5e4)".into(),
+        base.clone(),
+        true,
+    );
     for r in [5e3, 1e3, 5e2] {
         push(
             "bulk ratio",

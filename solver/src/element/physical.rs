@@ -99,7 +99,10 @@ pub fn element_frame(x: &[[f64; 3]; 8]) -> Option<([[f64; 3]; 3], [f64; 3])> {
     if r.determinant().is_nan() || r.determinant() <= 0.0 {
         return None;
     }
-    Some((std::array::from_fn(|i| std::array::from_fn(|j| r[(i, j)])), inv_len))
+    Some((
+        std::array::from_fn(|i| std::array::from_fn(|j| r[(i, j)])),
+        inv_len,
+    ))
 }
 
 /// Young's modulus and Poisson's ratio from a P-wave modulus `m` and a shear modulus `mu`:
@@ -130,13 +133,16 @@ pub fn add_forces<R: Real>(
 ) -> R {
     let rf = r.frame;
     // q[alpha][i]: generalised hourglass displacements (global components).
-    let q: [[R; 3]; 4] =
-        material::arr![4, |al| material::arr![3, |i| dot8(&u[i], &gamma[al]) * 0.125]];
+    let q: [[R; 3]; 4] = material::arr![4, |al| material::arr![3, |i| dot8(&u[i], &gamma[al])
+        * 0.125]];
     // q^ = R0^T F^T q, in the element frame.
     let qh: [[R; 3]; 4] = material::arr![4, |al| {
-        let qt: [R; 3] =
-            material::arr![3, |j| f[0][j] * q[al][0] + f[1][j] * q[al][1] + f[2][j] * q[al][2]];
-        material::arr![3, |j| rf[0][j] * qt[0] + rf[1][j] * qt[1] + rf[2][j] * qt[2]]
+        let qt: [R; 3] = material::arr![3, |j| f[0][j] * q[al][0]
+            + f[1][j] * q[al][1]
+            + f[2][j] * q[al][2]];
+        material::arr![3, |j| rf[0][j] * qt[0]
+            + rf[1][j] * qt[1]
+            + rf[2][j] * qt[2]]
     }];
     let (e, g, nu) = (R::splat(r.young), R::splat(r.shear), R::splat(r.poisson));
     let plate = R::splat(r.young / (1.0 - r.poisson * r.poisson));
@@ -190,8 +196,7 @@ pub fn add_forces<R: Real>(
             scale * fq[3][m],
         );
         for a in 0..8 {
-            fe[m][a] +=
-                c0 * gamma[0][a] + c1 * gamma[1][a] + c2 * gamma[2][a] + c3 * gamma[3][a];
+            fe[m][a] += c0 * gamma[0][a] + c1 * gamma[1][a] + c2 * gamma[2][a] + c3 * gamma[3][a];
         }
     }
     // The dependence of F on the nodes: sum_alpha q_alpha (x) Q~_alpha contracted with b_a.
@@ -233,7 +238,15 @@ mod tests {
             shear,
         };
         let mut fe = [[0.0; 8]; 3];
-        let w = add_forces(&r, geo.volume / 3.0, &f, &un, &gamma, &geo.mean_grad, &mut fe);
+        let w = add_forces(
+            &r,
+            geo.volume / 3.0,
+            &f,
+            &un,
+            &gamma,
+            &geo.mean_grad,
+            &mut fe,
+        );
         (fe, w)
     }
 
@@ -258,7 +271,11 @@ mod tests {
             let i = (2.0 * a[1]) * (2.0 * a[2]).powi(3) / 12.0;
             for (contraction, modulus) in [(nu, e), (0.0, e / (1.0 - nu * nu))] {
                 let u: [[f64; 3]; 8] = std::array::from_fn(|n| {
-                    let p = [a[0] * CORNERS[n][0], a[1] * CORNERS[n][1], a[2] * CORNERS[n][2]];
+                    let p = [
+                        a[0] * CORNERS[n][0],
+                        a[1] * CORNERS[n][1],
+                        a[2] * CORNERS[n][2],
+                    ];
                     [kappa * p[0] * p[2], -contraction * kappa * p[1] * p[2], 0.0]
                 });
                 let (_, w) = forces(&x, &u, e, mu);
@@ -276,7 +293,11 @@ mod tests {
         let x = box_corners(a, &Matrix3::identity());
         let th = 1e-3;
         let u: [[f64; 3]; 8] = std::array::from_fn(|n| {
-            let p = [a[0] * CORNERS[n][0], a[1] * CORNERS[n][1], a[2] * CORNERS[n][2]];
+            let p = [
+                a[0] * CORNERS[n][0],
+                a[1] * CORNERS[n][1],
+                a[2] * CORNERS[n][2],
+            ];
             [0.0, -th * p[0] * p[2], th * p[0] * p[1]]
         });
         let mu = 1.0e5;
@@ -366,7 +387,11 @@ mod tests {
             let case = |field: &dyn Fn([f64; 3]) -> [f64; 3]| {
                 let x = box_corners(a, &r);
                 let u: [[f64; 3]; 8] = std::array::from_fn(|n| {
-                    let p = [a[0] * CORNERS[n][0], a[1] * CORNERS[n][1], a[2] * CORNERS[n][2]];
+                    let p = [
+                        a[0] * CORNERS[n][0],
+                        a[1] * CORNERS[n][1],
+                        a[2] * CORNERS[n][2],
+                    ];
                     let ul = field(p);
                     let ug = r * nalgebra::Vector3::new(ul[0], ul[1], ul[2]);
                     [ug[0], ug[1], ug[2]]

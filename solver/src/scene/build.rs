@@ -329,7 +329,11 @@ fn bulk_knob(
         shear_pa: g0,
         wave_speed_m_s: [c0, m.initial_wave_speed()],
     };
-    let card = if k == k0 { card } else { card.with_bulk_modulus(k, g0) };
+    let card = if k == k0 {
+        card
+    } else {
+        card.with_bulk_modulus(k, g0)
+    };
     Ok((m, card, Some(change)))
 }
 
@@ -345,7 +349,11 @@ fn formulation(p: &PartSpec) -> Result<Formulation, String> {
         }
     };
     // The physical form's coefficient scales an energy that is exact at 1.
-    let default_q = if form == HourglassForm::Physical { 1.0 } else { 0.1 };
+    let default_q = if form == HourglassForm::Physical {
+        1.0
+    } else {
+        0.1
+    };
     let q = p.hourglass_coefficient.map(|x| x.0).unwrap_or(default_q);
     if !(0.0..=1.0).contains(&q) {
         return Err(format!("hourglass_coefficient must lie in [0, 1], got {q}"));
