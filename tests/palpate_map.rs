@@ -3,31 +3,37 @@
 //! and the colour of the largest ROI stress of the last sample (from `roi_stress.csv`) on its
 //! scale, which the cell drawn last (the largest) must show.
 
-use std::process::Command;
+use std::path::Path;
+use std::process::{Command, Output};
 use surrogate::ColourScale;
+
+/// A quick coarse press into `out`: 8 mm voxels, `depth` in a time of the same number of ms,
+/// samples every 1 ms, no VTK, and the `extra` options.
+fn coarse_press(out: &Path, depth_mm: u32, extra: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_palpa"))
+        .arg("palpate")
+        .args(extra)
+        .args([
+            "--voxel",
+            "8mm",
+            "--sample-interval",
+            "1ms",
+            "--no-vtk",
+            "--quiet",
+        ])
+        .args(["--duration", &format!("{depth_mm}ms")])
+        .args(["--depth", &format!("{depth_mm}mm")])
+        .arg("--out")
+        .arg(out)
+        .output()
+        .unwrap()
+}
 
 #[test]
 fn palpate_draws_the_stress_picture() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("p");
-    let o = Command::new(env!("CARGO_BIN_EXE_palpa"))
-        .args([
-            "palpate",
-            "--voxel",
-            "8mm",
-            "--duration",
-            "3ms",
-            "--depth",
-            "3mm",
-            "--sample-interval",
-            "1ms",
-            "--no-vtk",
-            "--quiet",
-            "--out",
-        ])
-        .arg(&out)
-        .output()
-        .unwrap();
+    let o = coarse_press(&out, 3, &[]);
     let err = String::from_utf8_lossy(&o.stderr);
     assert!(o.status.success() && !err.contains("panicked"), "{err}");
     // the last sample's stresses: the last column of roi_stress.csv
@@ -71,26 +77,7 @@ fn palpate_draws_the_stress_picture() {
 fn the_fast_preset_states_itself_and_the_bulk_moduli_it_ran() {
     let dir = tempfile::tempdir().unwrap();
     let out = dir.path().join("f");
-    let o = Command::new(env!("CARGO_BIN_EXE_palpa"))
-        .args([
-            "palpate",
-            "--fidelity",
-            "fast",
-            "--voxel",
-            "8mm",
-            "--duration",
-            "2ms",
-            "--depth",
-            "2mm",
-            "--sample-interval",
-            "1ms",
-            "--no-vtk",
-            "--quiet",
-            "--out",
-        ])
-        .arg(&out)
-        .output()
-        .unwrap();
+    let o = coarse_press(&out, 2, &["--fidelity", "fast"]);
     let text = String::from_utf8_lossy(&o.stdout);
     let err = String::from_utf8_lossy(&o.stderr);
     assert!(o.status.success(), "{text}{err}");

@@ -709,7 +709,7 @@ pub fn export(scene: &Scene, opts: &ExportOptions) -> Result<Exported, String> {
         let two_mu = 2.0 * m.initial_shear_modulus();
         let g0 = m.initial_shear_modulus();
         let k0 = lambda2mu - 2.0 * two_mu / 3.0;
-        max_e = max_e.max(9.0 * k0 * g0 / (3.0 * k0 + g0));
+        max_e = max_e.max(material::law::young_poisson(k0, g0).0);
         w.kw("PART");
         w.text_line(&p.name);
         let (elform, ihq, qm, element_note) = match p.formulation {

@@ -184,3 +184,12 @@ pub fn lame(e: f64, nu: f64) -> (f64, f64) {
     let lambda = e * nu / ((1.0 + nu) * (1.0 - 2.0 * nu));
     (lambda, mu)
 }
+
+/// Young's modulus and Poisson ratio from the bulk and shear moduli: (E, nu),
+/// `E = 9 K G / (3 K + G)`, `nu = (3 K - 2 G) / (2 (3 K + G))`.
+pub fn young_poisson(k: f64, g: f64) -> (f64, f64) {
+    (
+        9.0 * k * g / (3.0 * k + g),
+        (3.0 * k - 2.0 * g) / (2.0 * (3.0 * k + g)),
+    )
+}

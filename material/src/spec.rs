@@ -300,8 +300,9 @@ impl MaterialSpec {
             }
             MaterialSpec::SimplifiedRubber(f) => f.bulk_modulus = Pressure(k),
             MaterialSpec::PiecewiseLinearPlasticity(p) => {
-                p.youngs_modulus = Pressure(9.0 * k * g / (3.0 * k + g));
-                p.poisson_ratio = Number((3.0 * k - 2.0 * g) / (2.0 * (3.0 * k + g)));
+                let (e, nu) = crate::law::young_poisson(k, g);
+                p.youngs_modulus = Pressure(e);
+                p.poisson_ratio = Number(nu);
             }
         }
         s

@@ -550,13 +550,14 @@ impl Model {
             };
             if matches!(form, Formulation::OnePoint(h) if h.form == HourglassForm::Physical) {
                 let mu = law.initial_shear_modulus();
-                let (e, nu) = physical::young_poisson(lambda2mu, mu).ok_or_else(|| {
-                    SolverError::Invalid(format!(
-                        "part `{}`: physical hourglass control needs a positive shear and bulk modulus (its law has G = {mu:e} Pa, K = {:e} Pa)",
-                        part.name,
-                        lambda2mu - 4.0 * mu / 3.0
-                    ))
-                })?;
+                let k = lambda2mu - 4.0 * mu / 3.0;
+                if k.is_nan() || mu.is_nan() || k <= 0.0 || mu <= 0.0 {
+                    return Err(SolverError::Invalid(format!(
+                        "part `{}`: physical hourglass control needs a positive shear and bulk modulus (its law has G = {mu:e} Pa, K = {k:e} Pa)",
+                        part.name
+                    )));
+                }
+                let (e, nu) = material::law::young_poisson(k, mu);
                 g.hg_moduli = [e, nu, mu];
             }
             for &e in &elems {
@@ -721,27 +722,15 @@ impl Model {
 mod tests {
     use super::*;
 
-    /// Connectivity of an nx x ny x nz block of hexahedra, elements in x-fastest order.
+    /// Connectivity of an nx x ny x nz block of hexahedra (the box generator's, elements in
+    /// x-fastest order) and its node count.
     fn block(nx: u32, ny: u32, nz: u32) -> (Vec<[u32; 8]>, usize) {
-        let id = |i: u32, j: u32, k: u32| (k * (ny + 1) + j) * (nx + 1) + i;
-        let mut conn = Vec::new();
-        for k in 0..nz {
-            for j in 0..ny {
-                for i in 0..nx {
-                    conn.push([
-                        id(i, j, k),
-                        id(i + 1, j, k),
-                        id(i + 1, j + 1, k),
-                        id(i, j + 1, k),
-                        id(i, j, k + 1),
-                        id(i + 1, j, k + 1),
-                        id(i + 1, j + 1, k + 1),
-                        id(i, j + 1, k + 1),
-                    ]);
-                }
-            }
-        }
-        (conn, ((nx + 1) * (ny + 1) * (nz + 1)) as usize)
+        let spec = crate::generate::BoxSpec {
+            divisions: [nx as usize, ny as usize, nz as usize],
+            ..Default::default()
+        };
+        let mesh = crate::generate::box_mesh(&spec, "block").unwrap();
+        (mesh.elements, mesh.nodes.len())
     }
 
     /// Every chunk in exactly one colour, and no two chunks of a colour sharing a node.

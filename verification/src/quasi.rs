@@ -67,6 +67,20 @@ pub fn on(nodes: &[u32], dof: usize, value: Option<f64>) -> Constraint {
     }
 }
 
+impl Relaxed {
+    /// The relaxation if its residual reached the tolerance, else an error saying how far it got.
+    pub fn converged(self) -> Result<Relaxed, String> {
+        if self.converged {
+            Ok(self)
+        } else {
+            Err(format!(
+                "relaxation: residual {:.2e} after {} steps",
+                self.residual, self.steps
+            ))
+        }
+    }
+}
+
 /// Relax to equilibrium: at most `max_steps`, residual below `tolerance`.
 pub fn relax(
     model: Model,

@@ -105,19 +105,6 @@ pub fn element_frame(x: &[[f64; 3]; 8]) -> Option<([[f64; 3]; 3], [f64; 3])> {
     ))
 }
 
-/// Young's modulus and Poisson's ratio from a P-wave modulus `m` and a shear modulus `mu`:
-/// `E = 9 K mu / (3 K + mu)`, `nu = (3 K - 2 mu) / (2 (3 K + mu))`, `K = m - 4 mu / 3`;
-/// `None` unless both K and mu are positive.
-pub fn young_poisson(m: f64, mu: f64) -> Option<(f64, f64)> {
-    let k = m - 4.0 * mu / 3.0;
-    (k > 0.0 && mu > 0.0).then(|| {
-        (
-            9.0 * k * mu / (3.0 * k + mu),
-            (3.0 * k - 2.0 * mu) / (2.0 * (3.0 * k + mu)),
-        )
-    })
-}
-
 /// Adds the physical hourglass forces to `fe` and returns the stored hourglass energy (J).
 /// `scale` = Q V0 / 3 (m^3), `f` the mean deformation gradient, `u` the nodal displacements,
 /// `gamma` the unnormalised hourglass vectors, `grad` the mean gradient.

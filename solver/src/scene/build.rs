@@ -1,7 +1,8 @@
 //! Build a [`Scene`] (model, simulation, output plan) from a [`SceneSpec`].
 
+use super::bulk::bulk_knob;
 use super::contact_spec::HandScene;
-use super::def::{BulkChange, DtMin, HourglassGuard, PartDef, SceneDef, Setup};
+use super::def::{DtMin, HourglassGuard, PartDef, SceneDef, Setup};
 use super::spec::*;
 use crate::bc::{Constraint, Kinematic, NodalLoad};
 use crate::curve::Curve;
@@ -281,60 +282,6 @@ fn mesh_units(spec: &MeshSpec, file: &Path) -> Result<f64, String> {
             }
         }
     }
-}
-
-/// The incompressibility knob of a part (`max_bulk_ratio` or `bulk_modulus`): the law and its
-/// card with the bulk modulus that runs, and the change to state.
-fn bulk_knob(
-    p: &PartSpec,
-    material: Material,
-    card: material::MaterialSpec,
-) -> Result<(Material, material::MaterialSpec, Option<BulkChange>), String> {
-    let k0 = material.bulk_modulus();
-    let g0 = material.initial_shear_modulus();
-    let (setting, k) = match (p.max_bulk_ratio, p.bulk_modulus) {
-        (None, None) => return Ok((material, card, None)),
-        (Some(_), Some(_)) => {
-            return Err("give max_bulk_ratio or bulk_modulus, not both".into());
-        }
-        (Some(r), None) => {
-            let r = r.0;
-            if !(r.is_finite() && r > 2.0 / 3.0) {
-                return Err(format!(
-                    "max_bulk_ratio must be a finite K/G above 2/3 (Poisson ratio above 0), got {r}"
-                ));
-            }
-            (format!("max_bulk_ratio = {r}"), k0.min(r * g0))
-        }
-        (None, Some(k)) => (format!("bulk_modulus = {:e} Pa", k.0), k.0),
-    };
-    if k != k0 && matches!(material, Material::PiecewiseLinearPlasticity(_)) {
-        return Err(format!(
-            "{setting} would change the bulk modulus of a piecewise_linear_plasticity law, whose hardening is given through its Young's modulus: change the card's youngs_modulus and poisson_ratio instead"
-        ));
-    }
-    let c0 = material.initial_wave_speed();
-    let m = if k == k0 {
-        material
-    } else {
-        material
-            .with_bulk_modulus(k)
-            .map_err(|e| format!("{setting}: {e}"))?
-    };
-    let change = BulkChange {
-        part: p.name.clone(),
-        setting,
-        original_pa: k0,
-        applied_pa: k,
-        shear_pa: g0,
-        wave_speed_m_s: [c0, m.initial_wave_speed()],
-    };
-    let card = if k == k0 {
-        card
-    } else {
-        card.with_bulk_modulus(k, g0)
-    };
-    Ok((m, card, Some(change)))
 }
 
 fn formulation(p: &PartSpec) -> Result<Formulation, String> {

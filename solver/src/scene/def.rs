@@ -37,50 +37,7 @@ pub struct PartDef {
     pub bulk: Option<BulkChange>,
 }
 
-/// A part's bulk modulus as a scene changed it (`max_bulk_ratio` or `bulk_modulus` under
-/// `[[part]]`): stated before the run and in the summary, never applied silently.
-#[derive(Clone, Debug, PartialEq, serde::Serialize)]
-pub struct BulkChange {
-    /// Part name.
-    pub part: String,
-    /// What the scene asked for: `max_bulk_ratio = ...` or `bulk_modulus = ...`.
-    pub setting: String,
-    /// The law's own bulk modulus (Pa).
-    pub original_pa: f64,
-    /// The bulk modulus that runs (Pa).
-    pub applied_pa: f64,
-    /// The law's initial shear modulus (Pa).
-    pub shear_pa: f64,
-    /// Initial wave speed before and after (m/s).
-    pub wave_speed_m_s: [f64; 2],
-}
-
-impl BulkChange {
-    /// One line for the console.
-    pub fn describe(&self) -> String {
-        if self.applied_pa == self.original_pa {
-            format!(
-                "part `{}`: {} does not bind (K = {:.4e} Pa, K/G = {:.4e})",
-                self.part,
-                self.setting,
-                self.original_pa,
-                self.original_pa / self.shear_pa
-            )
-        } else {
-            format!(
-                "part `{}`: {}: bulk modulus {:.4e} -> {:.4e} Pa (K/G {:.4e} -> {:.4e}), wave speed {:.4e} -> {:.4e} m/s",
-                self.part,
-                self.setting,
-                self.original_pa,
-                self.applied_pa,
-                self.original_pa / self.shear_pa,
-                self.applied_pa / self.shear_pa,
-                self.wave_speed_m_s[0],
-                self.wave_speed_m_s[1]
-            )
-        }
-    }
-}
+pub use super::bulk::BulkChange;
 
 /// The smallest step before a run is stopped.
 #[derive(Clone, Copy, Debug, PartialEq)]

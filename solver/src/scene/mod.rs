@@ -5,6 +5,7 @@
 //! unknown material) name the key path and the line where its value appears.
 
 pub mod build;
+pub mod bulk;
 pub mod contact_spec;
 pub mod def;
 pub mod phantom_spec;

@@ -80,13 +80,7 @@ pub fn roller_block(form: solver::element::Formulation) -> Result<(f64, f64, f64
         lambda,
         mu,
     });
-    let r = relax(model(m, mat, form)?, c, Vec::new(), 1e-10, 100_000)?;
-    if !r.converged {
-        return Err(format!(
-            "relaxation: residual {:.2e} after {} steps",
-            r.residual, r.steps
-        ));
-    }
+    let r = relax(model(m, mat, form)?, c, Vec::new(), 1e-10, 100_000)?.converged()?;
     let reaction: f64 = ns["zmax"]
         .iter()
         .map(|&n| r.sim.reaction[n as usize][2])
@@ -163,13 +157,7 @@ pub fn clamped_level(
         lambda,
         mu,
     });
-    let r = relax(model(m, mat, form)?, c, Vec::new(), tolerance, 400_000)?;
-    if !r.converged {
-        return Err(format!(
-            "relaxation: residual {:.2e} after {} steps",
-            r.residual, r.steps
-        ));
-    }
+    let r = relax(model(m, mat, form)?, c, Vec::new(), tolerance, 400_000)?.converged()?;
     let fz: f64 = top.iter().map(|&n| r.sim.reaction[n as usize][2]).sum();
     let bulge = r.sim.u[at(level, "bulge_node").as_u64().unwrap() as usize][0];
     Ok((fz, bulge, r.steps, r.seconds))

@@ -97,13 +97,7 @@ pub fn generated_tip(
         mu,
         kinematics: Kinematics::Small,
     });
-    let r = relax(model(mesh, mat, form)?, c, loads, 1e-8, 2_000_000)?;
-    if !r.converged {
-        return Err(format!(
-            "relaxation: residual {:.2e} after {} steps",
-            r.residual, r.steps
-        ));
-    }
+    let r = relax(model(mesh, mat, form)?, c, loads, 1e-8, 2_000_000)?.converged()?;
     let work: f64 = nodal
         .iter()
         .map(|(&n, &fz)| fz * r.sim.u[n as usize][2])
@@ -156,13 +150,7 @@ pub fn tip_deflection(
         mu,
         kinematics: Kinematics::Small,
     });
-    let r = relax(model(mesh, mat, form)?, c, loads, 1e-10, 600_000)?;
-    if !r.converged {
-        return Err(format!(
-            "relaxation: residual {:.2e} after {} steps",
-            r.residual, r.steps
-        ));
-    }
+    let r = relax(model(mesh, mat, form)?, c, loads, 1e-10, 600_000)?.converged()?;
     let tip = vec_u32(m, "tip_centre_nodes");
     let uz = tip.iter().map(|&n| r.sim.u[n as usize][2]).sum::<f64>() / tip.len() as f64;
     Ok((uz, r.steps))
