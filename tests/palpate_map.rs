@@ -99,3 +99,23 @@ fn the_fast_preset_states_itself_and_the_bulk_moduli_it_ran() {
     let ribs = bulk.iter().find(|b| b["part"] == "ribs").unwrap();
     assert_eq!(ribs["applied_pa"], ribs["original_pa"]);
 }
+
+/// A `--max-bulk-ratio` that no material can have is refused before anything runs, naming the
+/// option, with a non-zero exit and no panic.
+#[test]
+fn an_impossible_bulk_ratio_is_refused_naming_it() {
+    let dir = tempfile::tempdir().unwrap();
+    for bad in ["NaN", "0.5", "-3", "inf"] {
+        let o = coarse_press(
+            &dir.path().join("k"),
+            2,
+            &[&format!("--max-bulk-ratio={bad}")],
+        );
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(!o.status.success(), "{bad}: accepted");
+        assert!(
+            err.contains("max bulk ratio") && !err.contains("panicked"),
+            "{bad}: {err}"
+        );
+    }
+}

@@ -306,6 +306,13 @@ impl PalpationSetup {
                 self.dt_factor
             ));
         }
+        if let Some(r) = self.max_bulk_ratio {
+            if r.is_nan() || r.is_infinite() || r <= 2.0 / 3.0 {
+                return Err(format!(
+                    "max bulk ratio must be a finite K/G above 2/3 (Poisson ratio above 0), got {r}"
+                ));
+            }
+        }
         match self.mass_scaling {
             Some(StepTarget::Step(t)) => pos(t, "mass-scaling target step")?,
             Some(StepTarget::Initial(k)) => pos(k, "mass-scaling multiple of the initial step")?,
