@@ -309,17 +309,7 @@ pub fn render_picture(p: &Picture, path: &Path) -> Result<()> {
 
 /// Writes an RGB buffer as a PNG, atomically.
 fn write_png(rgb8: &[u8], (w, h): (u32, u32), path: &Path) -> Result<()> {
-    let mut bytes = Vec::new();
-    {
-        let mut enc = png::Encoder::new(&mut bytes, w, h);
-        enc.set_color(png::ColorType::Rgb);
-        enc.set_depth(png::BitDepth::Eight);
-        let mut wr = enc
-            .write_header()
-            .map_err(|e| Error::format(path, e.to_string()))?;
-        wr.write_image_data(rgb8)
-            .map_err(|e| Error::format(path, e.to_string()))?;
-    }
+    let bytes = picture::encode_png(rgb8, w, h).map_err(|e| Error::format(path, e))?;
     write_atomic(path, |mut f| {
         f.write_all(&bytes).map_err(|e| Error::io(path, e))
     })
