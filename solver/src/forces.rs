@@ -176,6 +176,7 @@ pub fn element_loop(
             }
         });
         g.chunks = chunks;
+        let (mut hg_stored, mut hg_power) = (0.0, 0.0);
         for ch in &g.chunks {
             if let Some(e) = &ch.error {
                 return Err(e.clone());
@@ -197,8 +198,11 @@ pub fn element_loop(
                 tot.dt_min = ch.dt_min * g.dt_kappa;
                 tot.dt_elem = ch.dt_elem;
             }
+            // the run's totals in the order they always had (bitwise), the group's beside
             tot.hg_stored += ch.hg_stored;
             tot.hg_power += ch.hg_power;
+            hg_stored += ch.hg_stored;
+            hg_power += ch.hg_power;
             if ch.hg_peak > tot.hg_peak {
                 tot.hg_peak = ch.hg_peak;
                 tot.hg_peak_elem = ch.hg_peak_elem;
@@ -206,6 +210,8 @@ pub fn element_loop(
             tot.bulk_power += ch.bulk_power;
             tot.law_dissipation += ch.law_dissipation;
         }
+        g.hourglass.stored = hg_stored;
+        g.hourglass.power = hg_power;
     }
     Ok(tot)
 }

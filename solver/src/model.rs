@@ -187,6 +187,28 @@ pub struct Group {
     pub dt_floor: f64,
     /// Lumped volume of each element node (m^3), kept only with mass scaling (to add mass).
     pub lumped: Vec<[f64; 8]>,
+    /// The group's hourglass energy, for the summary's warning that names the part.
+    pub hourglass: GroupHourglass,
+}
+
+/// A group's hourglass energy: the stiffness form's stored energy and the viscous form's power
+/// at the last force evaluation, and the power integrated over the run (the physical form's
+/// energy is internal energy and is not counted here).
+#[derive(Clone, Copy, Debug, Default)]
+pub struct GroupHourglass {
+    /// Stored energy at the last force evaluation (J).
+    pub stored: f64,
+    /// Dissipation power at the last force evaluation (W).
+    pub power: f64,
+    /// Energy dissipated so far (J).
+    pub dissipated: f64,
+}
+
+impl GroupHourglass {
+    /// Stored plus dissipated energy (J).
+    pub fn total(&self) -> f64 {
+        self.stored + self.dissipated
+    }
 }
 
 /// Elements per parallel chunk (a multiple of [`LANES`]). Fixed, so partial sums are formed in
@@ -522,6 +544,7 @@ impl Model {
                 density_scale: Vec::new(),
                 colours: Vec::new(),
                 max_node: 0,
+                hourglass: GroupHourglass::default(),
                 chunks: vec![ChunkOut::default(); n.div_ceil(CHUNK)],
                 eroded: Vec::new(),
                 dt_kappa: 1.0,

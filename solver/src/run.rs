@@ -83,6 +83,8 @@ pub struct RunSummary {
     /// What the user should look at although the run finished (e.g. the hourglass energy
     /// above [`HOURGLASS_WARNING`] of the internal energy).
     pub warnings: Vec<String>,
+    /// Where the hourglass energy sits (per part, the element with the most in one step).
+    pub hourglass: HourglassReport,
     /// Threads used.
     pub threads: usize,
     /// Frames written.
@@ -109,12 +111,78 @@ impl RunSummary {
 /// (LS-DYNA users' rule of thumb: 10 %).
 pub const HOURGLASS_WARNING: f64 = 0.1;
 
-/// The summary's warnings for final energies.
-pub fn energy_warnings(internal: f64, hourglass: f64) -> Vec<String> {
+/// Where a run's hourglass energy sits: per part, and the element with the most in one step.
+#[derive(Clone, Debug, Default, Serialize)]
+pub struct HourglassReport {
+    /// Hourglass energy (J) per part that has any, largest first.
+    pub by_part: Vec<PartEnergy>,
+    /// The element with the largest hourglass energy of one step over the run.
+    pub peak: Option<HourglassElement>,
+}
+
+/// One part's energy.
+#[derive(Clone, Debug, Serialize)]
+pub struct PartEnergy {
+    /// Part name.
+    pub part: String,
+    /// Energy (J).
+    pub energy_j: f64,
+}
+
+/// An element's hourglass energy in one step.
+#[derive(Clone, Debug, Serialize)]
+pub struct HourglassElement {
+    /// Element id.
+    pub element: u32,
+    /// Its part.
+    pub part: String,
+    /// Its hourglass energy in that step (J).
+    pub energy_j: f64,
+    /// When (s).
+    pub time: f64,
+}
+
+impl HourglassReport {
+    /// The report of a simulation so far.
+    pub fn of(sim: &Simulation) -> Self {
+        HourglassReport {
+            by_part: sim
+                .hourglass_by_part()
+                .into_iter()
+                .map(|(part, energy_j)| PartEnergy { part, energy_j })
+                .collect(),
+            peak: sim.hourglass_peak().map(|p| HourglassElement {
+                element: p.element,
+                part: sim.part_of(p.element),
+                energy_j: p.energy,
+                time: p.time,
+            }),
+        }
+    }
+}
+
+/// The summary's warnings for final energies: the hourglass energy above
+/// [`HOURGLASS_WARNING`] of the internal energy, naming the part with the most and the element
+/// with the largest in one step.
+pub fn energy_warnings(internal: f64, hourglass: f64, hg: &HourglassReport) -> Vec<String> {
     let mut w = Vec::new();
     if internal > 0.0 && hourglass > HOURGLASS_WARNING * internal {
+        let mut where_ = String::new();
+        if let Some(p) = hg.by_part.first() {
+            where_ += &format!(
+                "; part `{}` holds {:.0} % of it",
+                p.part,
+                100.0 * p.energy_j / hourglass.max(1e-300)
+            );
+        }
+        if let Some(e) = &hg.peak {
+            where_ += &format!(
+                ", and element {} (part `{}`) had the most in one step ({:.3e} J at t = {:.4e} s)",
+                e.element, e.part, e.energy_j, e.time
+            );
+        }
         w.push(format!(
-            "the hourglass energy is {:.1} % of the internal energy (above {:.0} %): the one-point elements deform in modes their mean strain does not see; try hourglass = \"physical\" (or --element 1pt-physical), a finer mesh or F-bar elements, and stop such runs with [run] max_hourglass_ratio",
+            "the hourglass energy is {:.1} % of the internal energy (above {:.0} %){where_}: the one-point elements deform in modes their mean strain does not see; try hourglass = \"physical\" (or --element 1pt-physical), a finer mesh or F-bar elements, and stop such runs with [run] max_hourglass_ratio",
             100.0 * hourglass / internal,
             100.0 * HOURGLASS_WARNING
         ));
@@ -486,6 +554,7 @@ pub fn run_scene(
         share: (wall - total_stage).max(0.0) / wall,
     });
     let e = &sim.energy;
+    let hourglass = HourglassReport::of(sim);
     let summary = RunSummary {
         title: scene.title.clone(),
         status,
@@ -523,7 +592,8 @@ pub fn run_scene(
             .iter()
             .filter_map(|p| p.bulk.clone())
             .collect(),
-        warnings: energy_warnings(e.internal, e.hourglass),
+        warnings: energy_warnings(e.internal, e.hourglass, &hourglass),
+        hourglass,
         threads: rayon::current_num_threads(),
         frames: series.len(),
         eroded_elements: sim.erosion.count,
@@ -549,14 +619,29 @@ mod tests {
 
     #[test]
     fn hourglass_energy_above_a_tenth_of_the_internal_energy_is_warned_about() {
-        assert!(energy_warnings(1.0, 0.1).is_empty());
-        let w = energy_warnings(1.0, 0.24);
+        let hg = HourglassReport {
+            by_part: vec![PartEnergy {
+                part: "flesh".into(),
+                energy_j: 0.18,
+            }],
+            peak: Some(HourglassElement {
+                element: 42,
+                part: "flesh".into(),
+                energy_j: 1e-4,
+                time: 0.01,
+            }),
+        };
+        assert!(energy_warnings(1.0, 0.1, &hg).is_empty());
+        let w = energy_warnings(1.0, 0.24, &hg);
         assert_eq!(w.len(), 1);
         assert!(
-            w[0].contains("24.0 %") && w[0].contains("physical"),
+            w[0].contains("24.0 %")
+                && w[0].contains("physical")
+                && w[0].contains("part `flesh` holds 75 %")
+                && w[0].contains("element 42"),
             "{}",
             w[0]
         );
-        assert!(energy_warnings(0.0, 0.5).is_empty());
+        assert!(energy_warnings(0.0, 0.5, &hg).is_empty());
     }
 }

@@ -272,9 +272,21 @@ pub struct Simulation {
     totals: ElementTotals,
     initialised: bool,
     hg_dissipated: f64,
+    hg_worst: Option<HourglassPeak>,
     scratch_x: Vec<[f64; 3]>,
     scratch_targets: Vec<f64>,
     scratch_partials: Vec<[f64; 12]>,
+}
+
+/// The element with the largest hourglass energy of one step over the run so far.
+#[derive(Clone, Copy, Debug)]
+pub struct HourglassPeak {
+    /// Element (global id).
+    pub element: u32,
+    /// Its hourglass energy in that step (J): stored energy plus power x dt.
+    pub energy: f64,
+    /// The time (s).
+    pub time: f64,
 }
 
 /// Elements eroded by their law's failure criterion.
@@ -416,6 +428,7 @@ impl Simulation {
             totals: ElementTotals::default(),
             initialised: false,
             hg_dissipated: 0.0,
+            hg_worst: None,
             scratch_x: vec![[0.0; 3]; nn],
             scratch_targets: Vec::new(),
             scratch_partials: Vec::new(),
@@ -611,6 +624,28 @@ impl Simulation {
             }
         }
         Ok(())
+    }
+
+    /// Hourglass energy (J, stored plus dissipated; the physical form's is internal energy and
+    /// not counted) per part that has any, largest first.
+    pub fn hourglass_by_part(&self) -> Vec<(String, f64)> {
+        let mut by_part = vec![0.0; self.model.parts.len()];
+        for g in &self.model.groups {
+            by_part[g.part] += g.hourglass.total();
+        }
+        let mut v: Vec<(String, f64)> = by_part
+            .into_iter()
+            .enumerate()
+            .filter(|(_, e)| *e > 0.0)
+            .map(|(p, e)| (self.model.parts[p].name.clone(), e))
+            .collect();
+        v.sort_by(|a, b| b.1.total_cmp(&a.1));
+        v
+    }
+
+    /// The element with the largest hourglass energy in one step over the run so far.
+    pub fn hourglass_peak(&self) -> Option<HourglassPeak> {
+        self.hg_worst
     }
 
     /// Part name of an element.
@@ -840,6 +875,16 @@ impl Simulation {
         self.w_damp_acc = w_damp + s[5];
         let e = &mut self.energy;
         self.hg_dissipated += tot.hg_power * dt_avg;
+        for g in self.model.groups.iter_mut() {
+            g.hourglass.dissipated += g.hourglass.power * dt_avg;
+        }
+        if tot.hg_peak > self.hg_worst.map_or(0.0, |w| w.energy) {
+            self.hg_worst = Some(HourglassPeak {
+                element: tot.hg_peak_elem,
+                energy: tot.hg_peak,
+                time: t,
+            });
+        }
         e.hourglass = tot.hg_stored + self.hg_dissipated;
         e.bulk_viscous += tot.bulk_power * dt_avg;
         e.law_dissipation += tot.law_dissipation;

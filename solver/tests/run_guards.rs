@@ -62,6 +62,21 @@ fn hourglass_guard_names_the_element_and_the_time() {
         ratio > 0.1,
         "the case must excite hourglass modes (ratio {ratio})"
     );
+    // ... and the summary warns, naming the part that holds it and the element with the most
+    // in one step; the per-part energies add up to the run's hourglass energy.
+    let w = summary.warnings.join("\n");
+    assert!(
+        w.contains("hourglass energy is")
+            && w.contains("part `flesh` holds 100 %")
+            && w.contains("(part `flesh`) had the most in one step"),
+        "{w}"
+    );
+    let parts: f64 = summary.hourglass.by_part.iter().map(|p| p.energy_j).sum();
+    assert!(
+        (parts - summary.hourglass_energy).abs() <= 1e-12 * summary.hourglass_energy,
+        "per part {parts} J, total {} J",
+        summary.hourglass_energy
+    );
 
     let mut guarded = common::scene_from_str(&finger_scene("max_hourglass_ratio = 0.1"));
     let out2 = common::tmp_dir("hg-guard");
