@@ -22,20 +22,9 @@ use std::process::{Command, Output, Stdio};
 use std::time::{Duration, Instant};
 use surrogate::{Dataset, ViewGeometry};
 
-const TINY: &str = r#"
-title = "tiny"
-[phantom]
-voxel = "8 mm"
-[locations]
-train = ["P07", "P12"]
-test = ["A"]
-[indentation]
-depth = "2 mm"
-duration = "1 ms"
-sample_interval = "0.5 ms"
-"#;
-const RUNS: usize = 3;
-const SAMPLES: usize = 3;
+#[path = "support/tiny_campaign.rs"]
+mod tiny_campaign;
+use tiny_campaign::{done_count, tiny, RUNS, SAMPLES};
 
 fn palpa(args: &[&str]) -> Output {
     let out = Command::new(env!("CARGO_BIN_EXE_palpa"))
@@ -61,23 +50,8 @@ fn ok(args: &[&str]) -> String {
     stdout
 }
 
-fn tiny(dir: &Path) -> PathBuf {
-    let p = dir.join("tiny.toml");
-    std::fs::write(&p, TINY).unwrap();
-    p
-}
-
 fn s(p: &Path) -> &str {
     p.to_str().unwrap()
-}
-
-fn done_count(out: &Path) -> usize {
-    std::fs::read_dir(out.join("runs"))
-        .map(|d| {
-            d.filter(|e| e.as_ref().unwrap().path().join("done.json").is_file())
-                .count()
-        })
-        .unwrap_or(0)
 }
 
 /// The dataset has RUNS x SAMPLES rows in run order: locations 0, 1, 2, splits train, train,
