@@ -477,3 +477,36 @@ fn vtu_part_id_array_one_short_is_an_error() {
     assert_eq!(m.part_names, vec!["part_0", "part_2147483647"]);
     assert_eq!(m.element_part, vec![1, 0]);
 }
+
+/// Issue 29: a cut or foreign `.vtu` was refused with vtkio's error printed as Rust
+/// (`InvalidXml(IllFormed(MissingEndTag("DataArray")))`); the message now says what is wrong in
+/// words and names the file.
+#[test]
+fn a_cut_or_foreign_vtu_is_refused_in_words() {
+    let tmp = common::tmp_dir("vtu-words");
+    let whole = two_cells_vtu("0 1");
+    let p = tmp.path().join("cut.vtu");
+    let cut_at = whole.find("<DataArray").unwrap() + 40;
+    for (text, want) in [
+        (&whole[..cut_at], "ends early or is cut off"),
+        ("garbage\0\u{1}", "not VTK XML"),
+        (
+            "<VTKFile type=\"UnstructuredGrid\"><a></a></VTKFile>",
+            "malformed VTK XML: unknown variant `a`",
+        ),
+    ] {
+        std::fs::write(&p, text).unwrap();
+        let e = match read_mesh(&p, 1.0) {
+            Ok(_) => panic!("{text:?} must be refused"),
+            Err(e) => e,
+        };
+        assert!(e.contains("cut.vtu") && e.contains(want), "{e}");
+        assert!(
+            !e.contains("InvalidXml")
+                && !e.contains("IllFormed")
+                && !e.contains("Deserialization")
+                && !e.contains("Custom("),
+            "{e}"
+        );
+    }
+}

@@ -22,11 +22,56 @@ use std::io::Read;
 use std::path::Path;
 use vtkio::model::{Attribute, DataSet, VertexNumbers, Vtk};
 
+/// vtkio's error in words: it prints its XML parser's errors as Rust values
+/// (`Deserialization error: InvalidXml(IllFormed(MissingEndTag("DataArray")))`).
+fn xml_message(e: &vtkio::Error) -> String {
+    let raw = e.to_string();
+    let quoted = |key: &str| {
+        let i = raw.find(key)? + key.len();
+        let rest = &raw[i..];
+        let a = rest.find('"')? + 1;
+        let b = rest[a..].find('"')? + a;
+        Some(rest[a..b].to_string())
+    };
+    if let Some(tag) = quoted("MissingEndTag(") {
+        return format!("the file ends early or is cut off: the element <{tag}> is never closed");
+    }
+    if let (Some(want), Some(found)) = (quoted("expected:"), quoted("found:")) {
+        return format!("malformed XML: </{found}> closes <{want}>");
+    }
+    for (key, what) in [
+        ("UnclosedTag", "a tag"),
+        ("UnclosedComment", "a comment"),
+        ("UnclosedCData", "a CDATA section"),
+        ("UnclosedPIOrXmlDecl", "the XML declaration"),
+        ("UnclosedDoctype", "the DOCTYPE"),
+        ("UnexpectedEof", "the document"),
+    ] {
+        if raw.contains(key) {
+            return format!("the file ends early or is cut off: {what} is never closed");
+        }
+    }
+    if raw.contains("expected struct VTKFile") {
+        return "it does not begin with a <VTKFile> element: not VTK XML".into();
+    }
+    if raw.contains("NonDecodable") || raw.contains("Utf8") {
+        return "the file is not text (it holds bytes that are not UTF-8 outside <AppendedData>)"
+            .into();
+    }
+    // serde's own messages are words already; drop the Rust wrappers around them
+    if let Some(i) = raw.find("Custom(\"") {
+        let msg = raw[i + 8..].trim_end_matches(')').trim_end_matches('"');
+        return format!("malformed VTK XML: {}", msg.replace("\\\"", "\""));
+    }
+    format!("malformed VTK XML ({raw})")
+}
+
 /// Read a `.vtu` file.
 pub fn read(path: &Path) -> Result<RawMesh, String> {
     let p = path.display();
     let bytes = std::fs::read(path).map_err(|e| format!("{p}: cannot read: {e}"))?;
-    let vtk = Vtk::import(path).map_err(|e| format!("{p}: not a readable VTK XML file: {e}"))?;
+    let vtk = Vtk::import(path)
+        .map_err(|e| format!("{p}: not a readable VTK XML file: {}", xml_message(&e)))?;
     let piece = match vtk.data {
         DataSet::UnstructuredGrid { pieces, .. } => {
             if pieces.len() != 1 {
