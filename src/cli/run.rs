@@ -9,6 +9,16 @@ use std::path::Path;
 use std::time::Instant;
 
 /// Print the run summary.
+/// A fraction as a percentage that keeps two significant digits however small it is.
+fn percent(f: f64) -> String {
+    let p = 100.0 * f;
+    if p == 0.0 || p >= 0.01 {
+        format!("{p:.3} %")
+    } else {
+        format!("{p:.1e} %")
+    }
+}
+
 pub fn print_summary(s: &RunSummary) {
     println!("run `{}`: {}", s.title, s.status);
     println!(
@@ -24,13 +34,13 @@ pub fn print_summary(s: &RunSummary) {
         s.elements, s.nodes, s.dt_min, s.dt_max
     );
     println!(
-        "  energy: kinetic {:.4e} J, internal {:.4e} J, hourglass {:.4e} J, external work {:.4e} J; error {:.3} % (max {:.3} %)",
+        "  energy: kinetic {:.4e} J, internal {:.4e} J, hourglass {:.4e} J, external work {:.4e} J; error {} (largest over the run {} of its largest energy)",
         s.kinetic_energy,
         s.internal_energy,
         s.hourglass_energy,
         s.external_work,
-        100.0 * s.energy_error,
-        100.0 * s.max_energy_error
+        percent(s.energy_error),
+        percent(s.max_energy_error)
     );
     println!("  active stages: {}", s.active_stages.join(", "));
     println!("  where the time went:");
