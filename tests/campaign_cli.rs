@@ -17,14 +17,14 @@
 //!   resolve on their phantoms (`--dry-run`), the default raster covers the ROI's plan extent,
 //!   and a bad key is an error naming it.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::{Command, Output, Stdio};
 use std::time::{Duration, Instant};
 use surrogate::{Dataset, ViewGeometry};
 
 #[path = "support/tiny_campaign.rs"]
 mod tiny_campaign;
-use tiny_campaign::{done_count, tiny, RUNS, SAMPLES};
+use tiny_campaign::{done_count, tiny, RUNS, SAMPLES, TINY};
 
 fn palpa(args: &[&str]) -> Output {
     let out = Command::new(env!("CARGO_BIN_EXE_palpa"))
