@@ -59,7 +59,10 @@ pub struct CampaignArgs {
     #[arg(long)]
     resume: bool,
     /// Run only the runs k with k mod n == i (a deterministic subset, e.g. one Slurm array
-    /// task each); join the shards' directories with `palpa campaign merge`.
+    /// task each); join the shards' directories with `palpa campaign merge`. n is the
+    /// campaign's number of shards, fixed when the shard's directory is made: `--shard i`
+    /// alone takes it from --out's campaign.json (a resubmitted shard), and a count that
+    /// disagrees with it is refused.
     #[arg(long, value_name = "i/n")]
     shard: Option<String>,
     /// Runs side by side [default: as many as cores].
@@ -181,6 +184,106 @@ fn campaign_file(plan: &Value, shard: Option<(usize, usize)>) -> Value {
     })
 }
 
+/// The shard `DIR/campaign.json` records: `None` without that file, `Some(None)` for an
+/// unsharded campaign.
+fn recorded_shard(out: &Path) -> Result<Option<Option<(usize, usize)>>, String> {
+    let cfile = out.join(CAMPAIGN_FILE);
+    if !cfile.exists() {
+        return Ok(None);
+    }
+    shard_in(&read_json(&cfile)?, &cfile).map(Some)
+}
+
+/// The shard of the campaign description `v` (read from `cfile`), `None` when unsharded.
+fn shard_in(v: &Value, cfile: &Path) -> Result<Option<(usize, usize)>, String> {
+    match &v["shard"] {
+        Value::Null => Ok(None),
+        Value::String(s) => parse_shard(s)
+            .map(Some)
+            .map_err(|_| format!("{}: `shard` is `{s}`, not i/n", cfile.display())),
+        other => Err(format!(
+            "{}: `shard` is {other}, not \"i/n\"",
+            cfile.display()
+        )),
+    }
+}
+
+/// The shard of `--shard` (`i/n`, or `i` with n from `out`'s campaign.json), checked against
+/// the shard `out` already holds: a shard's count is fixed when its directory is made, so a
+/// resubmitted task (a Slurm array resubmitted as `--array=i` has SLURM_ARRAY_TASK_COUNT=1)
+/// can neither silently split the campaign differently nor fail on `i/1`.
+fn resolve_shard(arg: Option<&str>, out: &Path) -> Result<Option<(usize, usize)>, String> {
+    let recorded = recorded_shard(out)?;
+    let there = || out.join(CAMPAIGN_FILE).display().to_string();
+    let continue_with = |(i, n): (usize, usize)| {
+        format!("continue it with --shard {i}/{n} or --shard {i}, or choose a new --out")
+    };
+    let Some(arg) = arg else {
+        return match recorded {
+            Some(Some(r)) => Err(format!(
+                "{} holds shard {}/{} of a campaign (see {}), not the whole campaign: {}",
+                out.display(),
+                r.0,
+                r.1,
+                there(),
+                continue_with(r)
+            )),
+            _ => Ok(None),
+        };
+    };
+    let shard = if let Some((i, n)) = arg.split_once('/') {
+        match parse_shard(arg) {
+            Ok(s) => s,
+            Err(e) => {
+                let hint = match recorded {
+                    Some(Some(r)) => format!("; {} records shard {}/{}: {}", there(), r.0, r.1, continue_with(r)),
+                    _ if matches!((i.trim().parse::<usize>(), n.trim().parse::<usize>()), (Ok(i), Ok(n)) if i >= n) => "; n is the campaign's number of shards, the same for every task, not the size of the array that runs this one (an array resubmitted as --array=i has SLURM_ARRAY_TASK_COUNT=1)".into(),
+                    _ => String::new(),
+                };
+                return Err(format!("{e}{hint}"));
+            }
+        }
+    } else {
+        let i: usize = arg.trim().parse().map_err(|_| {
+            format!("--shard: expected i/n with 0 <= i < n (or i alone to continue a shard), got `{arg}`")
+        })?;
+        match recorded {
+            Some(Some(r)) => (i, r.1),
+            Some(None) => {
+                return Err(format!(
+                    "--shard {i}: {} holds an unsharded campaign, with no shard count to take",
+                    out.display()
+                ))
+            }
+            None => {
+                return Err(format!(
+                    "--shard {i}: no shard count: {} does not exist yet to take it from; give --shard {i}/n, n the campaign's number of shards",
+                    there()
+                ))
+            }
+        }
+    };
+    match recorded {
+        Some(Some(r)) if r != shard => Err(format!(
+            "--shard {}/{}: {} holds shard {}/{} of a campaign (see {}); a shard's count is fixed when its directory is made and is the same for every task: {}",
+            shard.0,
+            shard.1,
+            out.display(),
+            r.0,
+            r.1,
+            there(),
+            continue_with(r)
+        )),
+        Some(None) => Err(format!(
+            "--shard {}/{}: {} holds the whole (unsharded) campaign; choose a new --out for a shard",
+            shard.0,
+            shard.1,
+            out.display()
+        )),
+        _ => Ok(Some(shard)),
+    }
+}
+
 /// Number of cores.
 fn cores() -> usize {
     std::thread::available_parallelism()
@@ -200,7 +303,7 @@ fn run_campaign(a: &CampaignArgs) -> Result<(), String> {
         None => e,
     };
     let campaign = spec.resolve().map_err(in_file)?;
-    let shard = a.shard.as_deref().map(parse_shard).transpose()?;
+    let shard = resolve_shard(a.shard.as_deref(), &a.out)?;
     if a.jobs == Some(0) || a.threads == Some(0) {
         return Err("--jobs and --threads must be at least 1".into());
     }
@@ -273,14 +376,6 @@ fn run_campaign(a: &CampaignArgs) -> Result<(), String> {
                 old.get("solver_version").unwrap_or(&Value::Null),
                 env!("CARGO_PKG_VERSION")
             );
-        }
-        if old.get("shard") != desc.get("shard") {
-            return Err(format!(
-                "{} holds shard {} of this campaign, not {}",
-                out.display(),
-                old.get("shard").unwrap_or(&Value::Null),
-                desc["shard"]
-            ));
         }
     }
     if n_done > 0 && !a.resume {
@@ -769,6 +864,8 @@ fn copy_run(src: &Path, dst: &Path) -> Result<(), String> {
 /// `palpa campaign merge DIRS --out OUT`.
 fn merge(dirs: &[PathBuf], out: &Path, quiet: bool) -> Result<(), String> {
     let mut plan: Option<Value> = None;
+    // the shard counts the directories record (an unsharded one counts as 1)
+    let mut counts: Vec<usize> = Vec::new();
     for d in dirs {
         let v = read_json(&d.join(CAMPAIGN_FILE))?;
         if v["format"] != CAMPAIGN_FORMAT {
@@ -777,6 +874,7 @@ fn merge(dirs: &[PathBuf], out: &Path, quiet: bool) -> Result<(), String> {
                 d.join(CAMPAIGN_FILE).display()
             ));
         }
+        counts.push(shard_in(&v, &d.join(CAMPAIGN_FILE))?.map_or(1, |(_, n)| n));
         match &plan {
             None => plan = Some(v["plan"].clone()),
             Some(p) if *p != v["plan"] => {
@@ -811,7 +909,7 @@ fn merge(dirs: &[PathBuf], out: &Path, quiet: bool) -> Result<(), String> {
     };
     let mut missing = Vec::new();
     let mut copied = 0;
-    for l in &labels {
+    for (k, l) in labels.iter().enumerate() {
         let dst = run_dir(out, l);
         if read_done(&dst).is_some() {
             continue;
@@ -821,14 +919,33 @@ fn merge(dirs: &[PathBuf], out: &Path, quiet: bool) -> Result<(), String> {
                 copy_run(&run_dir(d, l), &dst)?;
                 copied += 1;
             }
-            _ => missing.push(l.as_str()),
+            _ => missing.push((k, l.as_str())),
         }
     }
     if !missing.is_empty() {
+        counts.sort_unstable();
+        counts.dedup();
+        // the shards the missing runs belong to, when the directories agree on the count
+        let which = match counts[..] {
+            [n] if n > 1 => {
+                let mut shards: Vec<usize> = missing.iter().map(|(k, _)| k % n).collect();
+                shards.sort_unstable();
+                shards.dedup();
+                let shards: Vec<String> = shards.iter().map(|i| format!("{i}/{n}")).collect();
+                format!(
+                    "the runs of shard{} {}: not given, or not finished (resubmit {} and merge again)",
+                    if shards.len() > 1 { "s" } else { "" },
+                    shards.join(", "),
+                    if shards.len() > 1 { "them" } else { "it" }
+                )
+            }
+            _ => "a shard not given or not finished?".into(),
+        };
+        let labels: Vec<&str> = missing.iter().map(|(_, l)| *l).collect();
         return Err(format!(
-            "merge: {} run(s) are finished in none of the directories: {} (a shard not given or not finished?)",
+            "merge: {} run(s) are finished in none of the directories: {} ({which})",
             missing.len(),
-            missing.join(", ")
+            labels.join(", ")
         ));
     }
     write_json(&out.join(CAMPAIGN_FILE), &campaign_file(&plan, None))?;
