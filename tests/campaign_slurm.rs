@@ -1,6 +1,6 @@
 //! A campaign on a Slurm array (scenes/campaign-slurm.sbatch, docs/cluster.md), without Slurm:
 //! the script's array tasks and merge run under bash with the variables Slurm would set, on the
-//! tiny campaign of tests/campaign_cli.rs (three runs of a few seconds). What broke:
+//! tiny campaign of tests/support/tiny_campaign.rs (three runs of about a second). What broke:
 //! - resubmitting one failed task (`sbatch --array=1`) set SLURM_ARRAY_TASK_COUNT=1 and the task
 //!   failed with `--shard ... got 1/1`: the shard count now comes from the record the first
 //!   submission left ($OUT/shard-count), and palpa refuses a count that disagrees with the
@@ -13,18 +13,9 @@
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
-const TINY: &str = r#"
-title = "tiny"
-[phantom]
-voxel = "8 mm"
-[locations]
-train = ["P07", "P12"]
-test = ["A"]
-[indentation]
-depth = "2 mm"
-duration = "1 ms"
-sample_interval = "0.5 ms"
-"#;
+#[path = "support/tiny_campaign.rs"]
+mod tiny_campaign;
+use tiny_campaign::tiny;
 
 fn root() -> &'static Path {
     Path::new(env!("CARGO_MANIFEST_DIR"))
@@ -62,8 +53,7 @@ struct Lab {
 impl Lab {
     fn new() -> Lab {
         let tmp = tempfile::tempdir().unwrap();
-        let file = tmp.path().join("tiny.toml");
-        std::fs::write(&file, TINY).unwrap();
+        let file = tiny(tmp.path());
         let out = tmp.path().join("campaign");
         Lab { tmp, file, out }
     }
