@@ -1,0 +1,12 @@
+//! afl.rs target `campaign`: [`palpa_fuzz::campaign`]. Built by `cargo afl build` it is the fuzz
+//! target; a plain build replays the files named on its command line.
+
+#[cfg(fuzzing)]
+fn main() {
+    afl::fuzz!(|data: &[u8]| palpa_fuzz::campaign(data));
+}
+
+#[cfg(not(fuzzing))]
+fn main() {
+    palpa_fuzz::replay_args("campaign", palpa_fuzz::campaign);
+}

@@ -1,0 +1,12 @@
+//! afl.rs target `model`: [`palpa_fuzz::model`]. Built by `cargo afl build` it is the fuzz
+//! target; a plain build replays the files named on its command line.
+
+#[cfg(fuzzing)]
+fn main() {
+    afl::fuzz!(|data: &[u8]| palpa_fuzz::model(data));
+}
+
+#[cfg(not(fuzzing))]
+fn main() {
+    palpa_fuzz::replay_args("model", palpa_fuzz::model);
+}
