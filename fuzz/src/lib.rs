@@ -6,7 +6,8 @@
 //! afl.rs turns into an abort, a crash) or a hang is a finding. Each harness bounds its work:
 //! inputs above [`MAX_TEXT`] (or [`MAX_BINARY`] for binary formats) are skipped, file names in
 //! an input may only name files in the harness's own directory, and the scene harness lowers
-//! `[mesh] max_elements` to [`MAX_FUZZ_ELEMENTS`] and builds one phantom only.
+//! `[mesh] max_elements` to [`MAX_FUZZ_ELEMENTS`] and builds one phantom only, the material
+//! harness lowers the driver's `max_steps` to [`MAX_FUZZ_DRIVER_STEPS`].
 
 use std::path::{Path, PathBuf};
 use std::sync::OnceLock;
@@ -18,6 +19,9 @@ pub const MAX_BINARY: usize = 256 * 1024;
 /// The most hexahedra a fuzzed box mesh may have (the scene's own `max_elements` is lowered to
 /// this).
 pub const MAX_FUZZ_ELEMENTS: f64 = 20_000.0;
+
+/// The most steps a fuzzed material driver path may take (its `max_steps` is lowered to this).
+pub const MAX_FUZZ_DRIVER_STEPS: f64 = 20_000.0;
 
 /// The targets, by name: the corpus directory `corpus/<name>/` and the binary of that name.
 pub const TARGETS: [(&str, fn(&[u8])); 11] = [
@@ -210,7 +214,9 @@ pub fn units(data: &[u8]) {
 pub fn material(data: &[u8]) {
     let Some(src) = local_toml(data) else { return };
     let dir = work_dir();
-    if let Ok(spec) = toml::from_str::<material::driver::DriverSpec>(src) {
+    if let Ok(mut spec) = toml::from_str::<material::driver::DriverSpec>(src) {
+        let limit = spec.max_steps.map_or(MAX_FUZZ_DRIVER_STEPS, |n| n.0);
+        spec.max_steps = Some(material::quantity::Number(limit.min(MAX_FUZZ_DRIVER_STEPS)));
         let r = material::driver::run_driver(&spec, Some(dir));
         verbose("driver", &r);
         if let Ok(out) = r {
