@@ -2,8 +2,8 @@
 //! reads; each binary in `src/bin/` feeds afl.rs's input to one of them, and
 //! `tests/corpus.rs` replays the committed corpus through them in a plain `cargo test`.
 //!
-//! A harness returns quietly whatever the parser answers, error or not: only a panic (which
-//! afl.rs turns into an abort, a crash) or a hang is a finding. Each harness bounds its work:
+//! A harness returns quietly whatever the parser answers, error or not: only a panic that
+//! reaches the harness (afl.rs turns it into an abort, a crash) or a hang is a finding. Each harness bounds its work:
 //! inputs above [`MAX_TEXT`] (or [`MAX_BINARY`] for binary formats) are skipped, file names in
 //! an input may only name files in the harness's own directory, and the scene harness lowers
 //! `[mesh] max_elements` to [`MAX_FUZZ_ELEMENTS`] and builds one phantom only, the material

@@ -477,3 +477,17 @@ fn vtu_part_id_array_one_short_is_an_error() {
     assert_eq!(m.part_names, vec!["part_0", "part_2147483647"]);
     assert_eq!(m.element_part, vec![1, 0]);
 }
+
+/// Found by the vtu fuzz target (docs/fuzzing.md): a zlib-compressed array whose block header
+/// is damaged (here the `offsets` array's) made vtkio slice past its data and panic; it is an
+/// error naming the file.
+#[test]
+fn a_vtu_with_a_damaged_compressed_header_is_an_error_not_a_panic() {
+    let e = read_mesh(&file("damaged-zlib-header.vtu"), 1.0)
+        .map(|_| ())
+        .unwrap_err();
+    assert!(
+        e.contains("damaged-zlib-header.vtu: the file's data is damaged: the VTK XML reader (vtkio) failed on it"),
+        "{e}"
+    );
+}
