@@ -9,6 +9,7 @@
 //! steps_per_segment = 100         # default 100; a segment may override with `steps`
 //! max_dt = "1 ms"                 # optional: more steps where a segment would exceed it
 //! output_every = 1                # write every k-th step (segment ends are always written)
+//! max_steps = 1e6                 # default; a path of more steps is refused before it runs
 //!
 //! [[segment]]                     # ramp to a stretch (shear for simple_shear) ...
 //! ramp_to = 1.3
@@ -89,6 +90,9 @@ pub struct DriverSpec {
     pub max_dt: Option<Time>,
     /// Write every k-th step (default 1).
     pub output_every: Option<usize>,
+    /// The most steps the whole path may take (default [`DEFAULT_MAX_STEPS`]); a longer path
+    /// is refused before it runs.
+    pub max_steps: Option<Number>,
     /// Path segments, in order.
     pub segment: Vec<SegmentSpec>,
 }
@@ -122,6 +126,10 @@ impl DriverOutput {
     }
 }
 
+/// The most steps a driver path may take unless `max_steps` raises the limit: a million rows
+/// of the table, seconds of work.
+pub const DEFAULT_MAX_STEPS: f64 = 1e6;
+
 /// A straight piece of the control history.
 struct Leg {
     duration: f64,
@@ -138,6 +146,23 @@ fn legs(spec: &DriverSpec, start: f64) -> Result<Vec<Leg>, String> {
     if spec.segment.is_empty() {
         return Err("the path has no `[[segment]]`".into());
     }
+    let max_steps = spec.max_steps.map_or(DEFAULT_MAX_STEPS, |n| n.0);
+    if !(max_steps >= 1.0) {
+        return Err(format!("`max_steps` must be at least 1, got {max_steps}"));
+    }
+    let mut total = 0.0;
+    // every leg goes through here: the path is refused as soon as it exceeds `max_steps`
+    let mut push = |out: &mut Vec<Leg>, leg: Leg, k: usize| -> Result<(), String> {
+        total += leg.steps as f64;
+        if total > max_steps {
+            return Err(format!(
+                "segment {}: the path takes more than {max_steps:.0} steps; use fewer `steps` or `steps_per_segment`, a larger `max_dt` or fewer `cycles`, or raise `max_steps` if you mean it",
+                k + 1
+            ));
+        }
+        out.push(leg);
+        Ok(())
+    };
     let mut out = Vec::new();
     let mut c = start;
     let steps_for = |dur: f64, s: Option<usize>| -> Result<usize, String> {
@@ -174,11 +199,15 @@ fn legs(spec: &DriverSpec, start: f64) -> Result<Vec<Leg>, String> {
                 }
                 let to = s.ramp_to.unwrap().0;
                 let d = ramp_duration(k, c, to, s.rate, s.duration)?;
-                out.push(Leg {
-                    duration: d,
-                    target: to,
-                    steps: steps_for(d, s.steps)?,
-                });
+                push(
+                    &mut out,
+                    Leg {
+                        duration: d,
+                        target: to,
+                        steps: steps_for(d, s.steps)?,
+                    },
+                    k,
+                )?;
                 c = to;
             }
             (false, true, false) => {
@@ -192,11 +221,15 @@ fn legs(spec: &DriverSpec, start: f64) -> Result<Vec<Leg>, String> {
                 if !(d >= 0.0) {
                     return Err(format!("segment {}: `hold` must be >= 0", k + 1));
                 }
-                out.push(Leg {
-                    duration: d,
-                    target: c,
-                    steps: steps_for(d, s.steps)?,
-                });
+                push(
+                    &mut out,
+                    Leg {
+                        duration: d,
+                        target: c,
+                        steps: steps_for(d, s.steps)?,
+                    },
+                    k,
+                )?;
             }
             (false, false, true) => {
                 let [lo, hi] = s.between.ok_or_else(|| {
@@ -211,11 +244,15 @@ fn legs(spec: &DriverSpec, start: f64) -> Result<Vec<Leg>, String> {
                 for _ in 0..s.cycles.unwrap() {
                     for to in [hi.0, lo.0] {
                         let d = ramp_duration(k, c, to, s.rate, None)?;
-                        out.push(Leg {
-                            duration: d,
-                            target: to,
-                            steps: steps_for(d, s.steps)?,
-                        });
+                        push(
+                            &mut out,
+                            Leg {
+                                duration: d,
+                                target: to,
+                                steps: steps_for(d, s.steps)?,
+                            },
+                            k,
+                        )?;
                         c = to;
                     }
                 }
@@ -499,5 +536,45 @@ mod tests {
         for (a, b) in d.iter().zip(want) {
             assert!((a - b).abs() < 1e-12, "{d:?}");
         }
+    }
+
+    /// Found while writing the material fuzz harness (docs/fuzzing.md), confirmed through it:
+    /// nothing bounded the path's steps, so a huge `steps_per_segment`, `cycles` count or a
+    /// tiny `max_dt` ran (and grew the table) for hours.
+    #[test]
+    fn a_driver_path_of_too_many_steps_is_an_error_not_a_hang() {
+        let head = "material = \"paper:ribs\"\nmode = \"uniaxial_strain\"\n";
+        for (keys, segment) in [
+            (
+                "steps_per_segment = 4000000000\n",
+                "ramp_to = 1.01\nduration = 1\n",
+            ),
+            (
+                "",
+                "cycles = 1000000000000000\nbetween = [0.9, 1.1]\nrate = 1\n",
+            ),
+            ("max_dt = \"1 ns\"\n", "hold = \"1000 s\"\n"),
+        ] {
+            let t = std::time::Instant::now();
+            let e =
+                run_driver_str(&format!("{head}{keys}[[segment]]\n{segment}"), None).unwrap_err();
+            assert!(t.elapsed().as_secs_f64() < 1.0, "{keys}{segment}");
+            assert!(
+                e.contains("segment 1: the path takes more than 1000000 steps"),
+                "{keys}{segment}: {e}"
+            );
+        }
+        // `max_steps` raises the limit, and must be at least 1
+        let spec: DriverSpec = toml::from_str(&format!(
+            "{head}max_steps = 3e6\nsteps_per_segment = 2000000\n[[segment]]\nhold = 1\n"
+        ))
+        .unwrap();
+        assert_eq!(legs(&spec, 1.0).unwrap()[0].steps, 2_000_000);
+        let e = run_driver_str(
+            &format!("{head}max_steps = 0\n[[segment]]\nhold = 1\n"),
+            None,
+        )
+        .unwrap_err();
+        assert!(e.contains("`max_steps` must be at least 1"), "{e}");
     }
 }

@@ -45,12 +45,10 @@ impl Dim {
     /// Stiffness per unit length (N/m).
     pub const STIFFNESS: Dim = Dim(1, 0, -2);
 
-    fn add(self, o: Dim, sign: i8) -> Dim {
-        Dim(
-            self.0 + sign * o.0,
-            self.1 + sign * o.1,
-            self.2 + sign * o.2,
-        )
+    /// `self` times `o` to the power `times`; `None` when an exponent leaves the `i8` range.
+    fn add(self, o: Dim, times: i32) -> Option<Dim> {
+        let e = |a: i8, b: i8| i8::try_from(a as i32 + times * b as i32).ok();
+        Some(Dim(e(self.0, o.0)?, e(self.1, o.1)?, e(self.2, o.2)?))
     }
 
     /// A human name for error messages.
@@ -212,11 +210,11 @@ fn parse_unit_expr(u: &str) -> Result<(f64, Dim), String> {
             let (f, d) = unit_symbol(sym).ok_or_else(|| {
                 format!("unknown unit `{sym}` in `{u}` (known: m cm mm um s ms us kg g t N kN Pa kPa MPa GPa J Hz ...)")
             })?;
-            let s = (sign * pow) as i32;
+            let s = sign as i32 * pow as i32;
             factor *= f.powi(s);
-            for _ in 0..pow.abs() {
-                dim = dim.add(d, sign * pow.signum());
-            }
+            dim = dim.add(d, s).ok_or_else(|| {
+                format!("unit `{u}`: its powers add up beyond what a unit can have (-128 to 127 per base unit)")
+            })?;
         }
     }
     Ok((factor, dim))
@@ -324,5 +322,34 @@ mod tests {
             .unwrap_err();
         assert!(e.contains("expected a length"), "{e}");
         assert!(Quantity::parse("kPa").is_err());
+    }
+
+    /// Found by fuzzing (docs/fuzzing.md): exponents that add up beyond `i8` overflowed (a panic
+    /// in debug builds, a wrapped, wrong dimension in release builds).
+    #[test]
+    fn a_unit_whose_powers_overflow_is_an_error_not_a_panic() {
+        for s in [
+            "2 mJ^71",
+            "2 m^127 m",
+            "1 1/m^-128",
+            "33 mJ m mJ mJ^81",
+            "1 s^-128 / s",
+        ] {
+            let e = Quantity::parse(s).unwrap_err();
+            assert!(e.contains("powers add up beyond"), "{s}: {e}");
+        }
+        // the largest powers still work
+        assert_eq!(
+            Quantity::parse("1 m^127").unwrap().dim,
+            Some(Dim(0, 127, 0))
+        );
+        assert_eq!(
+            Quantity::parse("1 m^-128").unwrap().dim,
+            Some(Dim(0, -128, 0))
+        );
+        assert_eq!(
+            Quantity::parse("1 1/m^-127").unwrap().dim,
+            Some(Dim(0, 127, 0))
+        );
     }
 }

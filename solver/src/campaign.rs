@@ -209,6 +209,11 @@ pub struct IndentationSpec {
     pub max_samples: Option<f64>,
 }
 
+/// The most runs a campaign may have (locations x depths x durations; a raster's points count
+/// as locations). A run takes minutes to hours: far more is a mistake in the file, refused
+/// before the plan is built.
+pub const MAX_RUNS: usize = 10_000;
+
 /// The most samples one run may record unless `[indentation] max_samples` raises the limit.
 pub const DEFAULT_MAX_SAMPLES: f64 = 1e6;
 
@@ -397,6 +402,12 @@ fn raster_locations(r: &RasterSpec) -> Result<(Split, Vec<CampaignLocation>), St
     let [nx, ny] = r.n;
     if nx == 0 || ny == 0 {
         return Err("locations.raster: n must be at least [1, 1]".into());
+    }
+    if nx.saturating_mul(ny) > MAX_RUNS {
+        return Err(format!(
+            "locations.raster: n = [{nx}, {ny}] gives {:.4e} points, more than a campaign's limit of {MAX_RUNS} runs",
+            nx as f64 * ny as f64
+        ));
     }
     let grid = crate::phantom::GridParams {
         center: [r.center[0].0, r.center[1].0],
@@ -604,17 +615,31 @@ impl CampaignSpec {
         if locations.is_empty() {
             return Err("locations: the campaign has no locations".into());
         }
-        for (i, a) in locations.iter().enumerate() {
-            if locations[..i].iter().any(|b| b.label == a.label) {
+        let mut seen = std::collections::HashSet::new();
+        for a in &locations {
+            if !seen.insert(a.label.as_str()) {
                 return Err(format!(
                     "locations: `{}` appears twice (a location is either train or test, once)",
                     a.label
                 ));
             }
         }
+        let n_runs = locations
+            .len()
+            .saturating_mul(depths.len())
+            .saturating_mul(timing.len());
+        if n_runs > MAX_RUNS {
+            return Err(format!(
+                "the campaign has {n_runs} runs ({} locations x {} depths x {} durations or speeds), more than the limit of {MAX_RUNS}",
+                locations.len(),
+                depths.len(),
+                timing.len()
+            ));
+        }
 
         let several = depths.len() * timing.len() > 1;
         let mut runs = Vec::new();
+        let mut labels = std::collections::HashSet::new();
         for (li, loc) in locations.iter().enumerate() {
             for &depth in &depths {
                 for tf in &timing {
@@ -636,7 +661,7 @@ impl CampaignSpec {
                     } else {
                         loc.label.clone()
                     };
-                    if runs.iter().any(|r: &PlannedRun| r.label == label) {
+                    if !labels.insert(label.clone()) {
                         return Err(format!("two runs would be labelled `{label}`: make the depths and durations distinct"));
                     }
                     runs.push(PlannedRun {
@@ -1221,5 +1246,66 @@ mod tests {
         );
         assert_eq!(parse_shard("1/3").unwrap(), (1, 3));
         assert!(parse_shard("3/3").is_err());
+    }
+
+    /// Found while writing the campaign fuzz harness (docs/fuzzing.md), confirmed through it: a
+    /// raster of 1e5 x 1e5 points was built point by point (hundreds of GiB) before anything
+    /// checked its size.
+    #[test]
+    fn a_campaign_with_a_huge_raster_is_an_error_not_a_hang() {
+        let spec: CampaignSpec = toml::from_str(
+            r#"
+            [locations]
+            raster = [{ center = [0, 0.2], spacing = ["1 mm", "1 mm"], n = [100000, 100000], split = "train" }]
+            "#,
+        )
+        .unwrap();
+        let t = std::time::Instant::now();
+        let e = spec.resolve().unwrap_err();
+        assert!(t.elapsed().as_secs_f64() < 1.0);
+        assert!(
+            e.contains("n = [100000, 100000]") && e.contains("limit of 10000 runs"),
+            "{e}"
+        );
+    }
+
+    /// Found with it too: hundreds of depths times hundreds of durations made millions of runs,
+    /// each label compared with every earlier one (a hang).
+    #[test]
+    fn a_campaign_with_too_many_runs_is_an_error_not_a_hang() {
+        let list = |unit: &str| {
+            (1..=400)
+                .map(|k| format!("\"{k} {unit}\""))
+                .collect::<Vec<_>>()
+                .join(", ")
+        };
+        let src = format!(
+            "[indentation]\ndepth = [{}]\nduration = [{}]\n",
+            list("um"),
+            list("ms")
+        );
+        let spec: CampaignSpec = toml::from_str(&src).unwrap();
+        let t = std::time::Instant::now();
+        let e = spec.resolve().unwrap_err();
+        assert!(t.elapsed().as_secs_f64() < 1.0);
+        assert!(
+            e.contains("4480000 runs (28 locations x 400 depths x 400 durations or speeds)")
+                && e.contains("limit of 10000"),
+            "{e}"
+        );
+        // at the limit, the plan is built
+        let list = |n: usize, unit: &str| {
+            (1..=n)
+                .map(|k| format!("\"{k} {unit}\""))
+                .collect::<Vec<_>>()
+                .join(", ")
+        };
+        let src = format!(
+            "[locations]\ntrain = [\"A\"]\ntest = [\"B\"]\n[indentation]\ndepth = [{}]\nduration = [{}]\n",
+            list(100, "um"),
+            list(50, "ms")
+        );
+        let spec: CampaignSpec = toml::from_str(&src).unwrap();
+        assert_eq!(spec.resolve().unwrap().runs.len(), MAX_RUNS);
     }
 }

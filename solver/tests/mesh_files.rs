@@ -510,3 +510,17 @@ fn a_cut_or_foreign_vtu_is_refused_in_words() {
         );
     }
 }
+
+/// Found by the vtu fuzz target (docs/fuzzing.md): a zlib-compressed array whose block header
+/// is damaged (here the `offsets` array's) made vtkio slice past its data and panic; it is an
+/// error naming the file.
+#[test]
+fn a_vtu_with_a_damaged_compressed_header_is_an_error_not_a_panic() {
+    let e = read_mesh(&file("damaged-zlib-header.vtu"), 1.0)
+        .map(|_| ())
+        .unwrap_err();
+    assert!(
+        e.contains("damaged-zlib-header.vtu: the file's data is damaged: the VTK XML reader (vtkio) failed on it"),
+        "{e}"
+    );
+}

@@ -11,6 +11,7 @@ mod material;
 mod mesh;
 mod palpate;
 mod predict;
+mod predict_line;
 mod progress;
 mod run;
 mod study;

@@ -21,6 +21,7 @@
 //!   skipped. A closed stdout (the reader has gone) ends the stream quietly. The model is
 //!   loaded once ([`surrogate::Predictor`], the hand-written forward pass).
 
+use super::predict_line::{check_finite, parse_input_line};
 use serde_json::{json, Map, Value};
 use std::fmt::Write as _;
 use std::io::{BufRead, Write};
@@ -91,15 +92,6 @@ pub fn load_model(path: &Path) -> Result<Predictor, String> {
 pub fn load_served(path: &Path) -> Result<ServedModel, String> {
     check_model_path(path)?;
     ServedModel::load(path).map_err(|e| format!("model {}: {e}", path.display()))
-}
-
-/// One input value, which must be a finite number.
-fn check_finite(name: &str, v: f64) -> Result<f64, String> {
-    if v.is_finite() {
-        Ok(v)
-    } else {
-        Err(format!("{name} = {v} is not a finite number"))
-    }
 }
 
 /// A prediction with a NaN or infinite stress or variance (a damaged model) is an error, not
@@ -198,36 +190,6 @@ fn write_or_closed(r: std::io::Result<()>) -> Result<bool, String> {
     }
 }
 
-/// The (x, y, force) of one JSON input line, and its optional `id`.
-fn parse_line(text: &str) -> Result<([f64; 3], Option<Value>), String> {
-    let v: Value = serde_json::from_str(text).map_err(|e| format!("not JSON: {e}"))?;
-    let Value::Object(mut obj) = v else {
-        return Err(r#"expected an object {"x": .., "y": .., "force": ..}"#.into());
-    };
-    let id = obj.remove("id");
-    let mut take = |name: &str, unit: &str| -> Result<f64, String> {
-        match obj.remove(name) {
-            None => Err(format!("missing field \"{name}\" (a number, {unit})")),
-            Some(Value::Number(n)) => {
-                let v = n
-                    .as_f64()
-                    .ok_or_else(|| format!("field \"{name}\": {n} is not a number"))?;
-                check_finite(name, v)
-            }
-            Some(other) => Err(format!(
-                "field \"{name}\": expected a plain number ({unit}), got {other}"
-            )),
-        }
-    };
-    let input = [take("x", "m")?, take("y", "m")?, take("force", "N")?];
-    if let Some(k) = obj.keys().next() {
-        return Err(format!(
-            "unknown field \"{k}\" (expected x, y, force and optionally id)"
-        ));
-    }
-    Ok((input, id))
-}
-
 /// Streaming prediction: JSON lines in, JSON lines out (see the module doc).
 pub fn predict_stdin(model: &Path) -> Result<(), String> {
     let mut p = load_model(model)?;
@@ -248,16 +210,7 @@ pub fn predict_stdin(model: &Path) -> Result<(), String> {
         }
         n += 1;
         // A line that is not UTF-8 gets its error reply; the stream goes on.
-        let parsed = std::str::from_utf8(&buf)
-            .map_err(|e| format!("not valid UTF-8 ({e})"))
-            .and_then(|line| {
-                if line.trim().is_empty() {
-                    Ok(None)
-                } else {
-                    parse_line(line).map(Some)
-                }
-            });
-        let parsed = match parsed {
+        let parsed = match parse_input_line(&buf) {
             Ok(None) => continue,
             Ok(Some(v)) => Ok(v),
             Err(e) => Err(e),

@@ -70,25 +70,7 @@ fn xml_message(e: &vtkio::Error) -> String {
 pub fn read(path: &Path) -> Result<RawMesh, String> {
     let p = path.display();
     let bytes = std::fs::read(path).map_err(|e| format!("{p}: cannot read: {e}"))?;
-    let vtk = Vtk::import(path)
-        .map_err(|e| format!("{p}: not a readable VTK XML file: {}", xml_message(&e)))?;
-    let piece = match vtk.data {
-        DataSet::UnstructuredGrid { pieces, .. } => {
-            if pieces.len() != 1 {
-                return Err(format!(
-                    "{p}: the grid has {} pieces; palpa reads single-piece files (in ParaView: Merge Blocks, then save)",
-                    pieces.len()
-                ));
-            }
-            pieces
-                .into_iter()
-                .next()
-                .unwrap()
-                .into_loaded_piece_data(Some(path))
-                .map_err(|e| format!("{p}: {e}"))?
-        }
-        _ => return Err(format!("{p}: not an unstructured grid")),
-    };
+    let piece = vtkio_guarded(&p.to_string(), || load_piece(path))?;
     let pts: Vec<f64> = piece
         .points
         .cast_into()
@@ -162,6 +144,46 @@ pub fn read(path: &Path) -> Result<RawMesh, String> {
     let names = field_strings(&bytes, "part_names").map_err(|e| format!("{p}: {e}"))?;
     raw.part_names = names_from(names);
     Ok(raw)
+}
+
+/// The grid's single piece, with its data loaded, as vtkio reads it.
+fn load_piece(path: &Path) -> Result<vtkio::model::UnstructuredGridPiece, String> {
+    let p = path.display();
+    let vtk = Vtk::import(path)
+        .map_err(|e| format!("{p}: not a readable VTK XML file: {}", xml_message(&e)))?;
+    match vtk.data {
+        DataSet::UnstructuredGrid { pieces, .. } => {
+            if pieces.len() != 1 {
+                return Err(format!(
+                    "{p}: the grid has {} pieces; palpa reads single-piece files (in ParaView: Merge Blocks, then save)",
+                    pieces.len()
+                ));
+            }
+            pieces
+                .into_iter()
+                .next()
+                .unwrap()
+                .into_loaded_piece_data(Some(path))
+                .map_err(|e| format!("{p}: {e}"))
+        }
+        _ => Err(format!("{p}: not an unstructured grid")),
+    }
+}
+
+/// Run vtkio on a file: vtkio 0.7 slices compressed data by the sizes its block header states,
+/// unchecked, and panics on a damaged header; that panic is this file's error (the panic
+/// message is printed first, by the panic hook).
+fn vtkio_guarded<T>(p: &str, f: impl FnOnce() -> Result<T, String>) -> Result<T, String> {
+    std::panic::catch_unwind(std::panic::AssertUnwindSafe(f)).unwrap_or_else(|e| {
+        let why = e
+            .downcast_ref::<String>()
+            .map(String::as_str)
+            .or_else(|| e.downcast_ref::<&str>().copied())
+            .unwrap_or("a panic");
+        Err(format!(
+            "{p}: the file's data is damaged: the VTK XML reader (vtkio) failed on it ({why})"
+        ))
+    })
 }
 
 /// The first of `names` that the file's `<CellData>` declares as a `DataArray`, if any.

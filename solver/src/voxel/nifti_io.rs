@@ -111,6 +111,17 @@ pub fn read_nifti(path: &Path) -> Result<LabelVolume, String> {
     }
     let obj = ReaderOptions::new().read_file(path).map_err(err)?;
     let h = obj.header().clone();
+    // The nifti crate sizes the voxel data by `bitpix` but decodes it by `datatype`; when the
+    // two disagree it panics while decoding.
+    let dt = h.data_type().map_err(err)?;
+    if h.bitpix as usize != 8 * dt.size_of() {
+        return Err(format!(
+            "{}: the header's bitpix ({}) does not match its datatype ({dt:?}, {} bits a voxel); the header is damaged",
+            path.display(),
+            h.bitpix,
+            8 * dt.size_of()
+        ));
+    }
     let nd = h.dim[0] as usize;
     if !(3..=7).contains(&nd) {
         return Err(format!(

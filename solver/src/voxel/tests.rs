@@ -331,3 +331,30 @@ fn preview_writes_three_pngs() {
     }
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// Found by the nifti fuzz target (docs/fuzzing.md): a header whose `datatype` disagrees with
+/// its `bitpix` (here int64 with 8 bits, and uint8 with 0) made the nifti crate panic while
+/// decoding the voxels ("Inconsistent raw data size").
+#[test]
+fn a_nifti_whose_bitpix_disagrees_with_its_datatype_is_an_error_not_a_panic() {
+    let dir = std::env::temp_dir().join(format!("palpa-nifti-bitpix-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let v = LabelVolume::new([4, 3, 2], [1e-3; 3], [0.0; 3]);
+    let good = dir.join("good.nii");
+    write_nifti(&v, &good).unwrap();
+    let bytes = std::fs::read(&good).unwrap();
+    // datatype at byte 70, bitpix at byte 72 (little-endian i16)
+    for (datatype, bitpix, name) in [(1024i16, 8i16, "int64"), (2, 0, "uint8")] {
+        let mut b = bytes.clone();
+        b[70..72].copy_from_slice(&datatype.to_le_bytes());
+        b[72..74].copy_from_slice(&bitpix.to_le_bytes());
+        let p = dir.join(format!("bad-{name}.nii"));
+        std::fs::write(&p, &b).unwrap();
+        let e = read_nifti(&p).unwrap_err();
+        assert!(
+            e.contains(&format!("bitpix ({bitpix}) does not match its datatype")),
+            "{name}: {e}"
+        );
+    }
+    std::fs::remove_dir_all(&dir).ok();
+}
