@@ -103,9 +103,7 @@ impl Lab {
         task: Option<(usize, usize, usize)>,
         shards: Option<&str>,
     ) -> String {
-        let o = self.script(mode, task, shards);
-        assert!(o.status.success(), "{mode:?} {task:?}: {}", text(&o));
-        text(&o)
+        self.expect(true, mode, task, shards)
     }
 
     fn fails(
@@ -114,10 +112,22 @@ impl Lab {
         task: Option<(usize, usize, usize)>,
         shards: Option<&str>,
     ) -> String {
+        self.expect(false, mode, task, shards)
+    }
+
+    /// The script's output, after asserting that it succeeded (or failed) as `success` says.
+    fn expect(
+        &self,
+        success: bool,
+        mode: Option<&str>,
+        task: Option<(usize, usize, usize)>,
+        shards: Option<&str>,
+    ) -> String {
         let o = self.script(mode, task, shards);
-        assert!(
-            !o.status.success(),
-            "{mode:?} {task:?} succeeded: {}",
+        assert_eq!(
+            o.status.success(),
+            success,
+            "{mode:?} {task:?}: {}",
             text(&o)
         );
         text(&o)

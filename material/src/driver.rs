@@ -150,19 +150,6 @@ fn legs(spec: &DriverSpec, start: f64) -> Result<Vec<Leg>, String> {
     if !(max_steps >= 1.0) {
         return Err(format!("`max_steps` must be at least 1, got {max_steps}"));
     }
-    let mut total = 0.0;
-    // every leg goes through here: the path is refused as soon as it exceeds `max_steps`
-    let mut push = |out: &mut Vec<Leg>, leg: Leg, k: usize| -> Result<(), String> {
-        total += leg.steps as f64;
-        if total > max_steps {
-            return Err(format!(
-                "segment {}: the path takes more than {max_steps:.0} steps; use fewer `steps` or `steps_per_segment`, a larger `max_dt` or fewer `cycles`, or raise `max_steps` if you mean it",
-                k + 1
-            ));
-        }
-        out.push(leg);
-        Ok(())
-    };
     let mut out = Vec::new();
     let mut c = start;
     let steps_for = |dur: f64, s: Option<usize>| -> Result<usize, String> {
@@ -174,6 +161,25 @@ fn legs(spec: &DriverSpec, start: f64) -> Result<Vec<Leg>, String> {
             n = n.max((dur / m).ceil() as usize);
         }
         Ok(n)
+    };
+    let mut total = 0.0;
+    // every leg goes through here: its steps are counted and the path is refused as soon as it
+    // exceeds `max_steps`
+    let mut push = |duration: f64, target: f64, steps: Option<usize>, k: usize| {
+        let steps = steps_for(duration, steps)?;
+        total += steps as f64;
+        if total > max_steps {
+            return Err(format!(
+                "segment {}: the path takes more than {max_steps:.0} steps; use fewer `steps` or `steps_per_segment`, a larger `max_dt` or fewer `cycles`, or raise `max_steps` if you mean it",
+                k + 1
+            ));
+        }
+        out.push(Leg {
+            duration,
+            target,
+            steps,
+        });
+        Ok(())
     };
     let ramp_duration = |k: usize,
                          from: f64,
@@ -199,15 +205,7 @@ fn legs(spec: &DriverSpec, start: f64) -> Result<Vec<Leg>, String> {
                 }
                 let to = s.ramp_to.unwrap().0;
                 let d = ramp_duration(k, c, to, s.rate, s.duration)?;
-                push(
-                    &mut out,
-                    Leg {
-                        duration: d,
-                        target: to,
-                        steps: steps_for(d, s.steps)?,
-                    },
-                    k,
-                )?;
+                push(d, to, s.steps, k)?;
                 c = to;
             }
             (false, true, false) => {
@@ -221,15 +219,7 @@ fn legs(spec: &DriverSpec, start: f64) -> Result<Vec<Leg>, String> {
                 if !(d >= 0.0) {
                     return Err(format!("segment {}: `hold` must be >= 0", k + 1));
                 }
-                push(
-                    &mut out,
-                    Leg {
-                        duration: d,
-                        target: c,
-                        steps: steps_for(d, s.steps)?,
-                    },
-                    k,
-                )?;
+                push(d, c, s.steps, k)?;
             }
             (false, false, true) => {
                 let [lo, hi] = s.between.ok_or_else(|| {
@@ -244,15 +234,7 @@ fn legs(spec: &DriverSpec, start: f64) -> Result<Vec<Leg>, String> {
                 for _ in 0..s.cycles.unwrap() {
                     for to in [hi.0, lo.0] {
                         let d = ramp_duration(k, c, to, s.rate, None)?;
-                        push(
-                            &mut out,
-                            Leg {
-                                duration: d,
-                                target: to,
-                                steps: steps_for(d, s.steps)?,
-                            },
-                            k,
-                        )?;
+                        push(d, to, s.steps, k)?;
                         c = to;
                     }
                 }
