@@ -457,6 +457,31 @@ fn step_constants(law: &Material) -> (f64, f64) {
     (c0, surface_mode_factor(m, law.initial_shear_modulus()))
 }
 
+/// Smallest `kappa L / c0` over the mesh displaced by `u` (s), each element's length
+/// `L = V / A_max` taken at its reference volume (`L (V0 / V)^(1/3)`): the step that the same
+/// shapes would give a nearly incompressible run, whose elements keep their volume. Inverted
+/// elements are skipped. `palpa check`'s pilot follows the run's step with it.
+pub fn isochoric_step_at(mesh: &Mesh, parts: &[Part], u: &[[f64; 3]]) -> f64 {
+    let props: Vec<(f64, f64)> = parts.iter().map(|p| step_constants(&p.material)).collect();
+    let mut dt = f64::INFINITY;
+    for (e, conn) in mesh.elements.iter().enumerate() {
+        let x0: [[f64; 3]; 8] = std::array::from_fn(|a| mesh.nodes[conn[a] as usize]);
+        let x: [[f64; 3]; 8] = std::array::from_fn(|a| {
+            let (p, d) = (x0[a], u[conn[a] as usize]);
+            [p[0] + d[0], p[1] + d[1], p[2] + d[2]]
+        });
+        if let (Ok(g0), Ok(g), Some(&(c0, kappa))) = (
+            element_geometry(&x0),
+            element_geometry(&x),
+            props.get(mesh.element_part[e] as usize),
+        ) {
+            let iso = (g0.volume / g.volume).cbrt();
+            dt = dt.min(kappa * iso * initial_element_dt(&x, g.volume, c0));
+        }
+    }
+    dt
+}
+
 /// Smallest initial `kappa L / c` over the mesh (s), without mass scaling. Inverted elements
 /// are skipped here (the model build reports them).
 fn natural_step(mesh: &Mesh, parts: &[Part]) -> f64 {

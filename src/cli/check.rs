@@ -6,8 +6,23 @@ use super::input::{check_failed_deck, load, print_report, DeckArgs};
 use solver::hex::corner_jacobians;
 use std::path::Path;
 
+/// When `check` runs the pilot that follows the step as elements shrink
+/// ([`solver::scene::pilot`]).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Pilot {
+    /// Whatever it costs (`--pilot`).
+    Always,
+    /// When it costs at most [`PILOT_BUDGET`] element-cycles (the default).
+    WhenCheap,
+    /// Never (`--no-pilot`).
+    Never,
+}
+
+/// The most element-cycles the pilot may cost unless `--pilot` asks for it (a few seconds).
+pub const PILOT_BUDGET: f64 = 5e7;
+
 /// Validate a scene or deck and report what a run would do.
-pub fn check(path: &Path, deck: &DeckArgs) -> Result<(), String> {
+pub fn check(path: &Path, deck: &DeckArgs, pilot: Pilot) -> Result<(), String> {
     let loaded = match load(path, deck) {
         Ok(l) => l,
         Err(e) => {
@@ -92,12 +107,13 @@ pub fn check(path: &Path, deck: &DeckArgs) -> Result<(), String> {
         dt_max.is_finite().then_some(dt_max),
         scene.end_time,
     );
+    let capped = dt_max.is_finite() && dt_max < f * dt0;
     println!(
-        "  estimated steps: {:.0} ({:.3e} element-cycles) for end time {:.4} ms{} (at the starting step; elements that shrink under load lower it, so a run may take more)",
+        "  estimated steps at the starting step: {:.0} ({:.3e} element-cycles) for end time {:.4} ms{}",
         steps,
         steps * mesh.elements.len() as f64,
         scene.end_time * 1e3,
-        if dt_max.is_finite() && dt_max < f * dt0 {
+        if capped {
             format!(", the step capped by dt_max = {dt_max:.4e} s")
         } else {
             String::new()
@@ -132,5 +148,65 @@ pub fn check(path: &Path, deck: &DeckArgs) -> Result<(), String> {
         );
     }
     println!("  stages: {}", sim.active_stages().join(", "));
+    let elements = mesh.elements.len();
+    print_pilot(path, &scene, pilot, lsdyna::is_deck(path), elements);
     Ok(())
+}
+
+/// Run the pilot when asked or cheap and print its estimate, or why there is none.
+fn print_pilot(
+    path: &Path,
+    scene: &solver::scene::Scene,
+    pilot: Pilot,
+    deck: bool,
+    elements: usize,
+) {
+    use solver::scene::pilot::{self, PilotPlan, PILOT_BULK_RATIO};
+    let why_not = |why: &str| {
+        println!("  pilot: none ({why}); a run may take more steps than the starting step gives when elements shrink under load");
+    };
+    if pilot == Pilot::Never {
+        return why_not("--no-pilot");
+    }
+    if deck {
+        return why_not(
+            "keyword decks keep the starting estimate; a scene written by `palpa export` gets one",
+        );
+    }
+    let plan = match pilot::plan(path, scene) {
+        Ok(p) => p,
+        Err(e) => return why_not(&format!("its scene did not build: {e}")),
+    };
+    let (pilot_scene, cost, capped) = match plan {
+        PilotPlan::NotNeeded(why) => {
+            println!("  pilot: none ({why}); the starting step is the estimate");
+            return;
+        }
+        PilotPlan::Ready {
+            scene,
+            element_cycles,
+            capped,
+        } => (*scene, element_cycles, capped),
+    };
+    if pilot == Pilot::WhenCheap && cost > PILOT_BUDGET {
+        return why_not(&format!(
+            "it would cost {cost:.2e} element-cycles, above {PILOT_BUDGET:.0e}; --pilot runs it"
+        ));
+    }
+    let est = pilot::run(pilot_scene, scene);
+    println!(
+        "  estimated steps with the pilot: {:.0} ({:.3e} element-cycles): the pilot (K/G capped at {PILOT_BULK_RATIO} on {}) took {} steps in {:.1} s, the element step falling to {:.2} of its start",
+        est.steps,
+        est.steps * elements as f64,
+        capped.join(", "),
+        est.pilot_steps,
+        est.wall.as_secs_f64(),
+        est.min_ratio
+    );
+    if let Some(why) = &est.stopped {
+        println!(
+            "  pilot stopped at t = {:.4} ms (the estimate covers the time up to there): {why}",
+            est.reached * 1e3
+        );
+    }
 }

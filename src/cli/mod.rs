@@ -68,6 +68,13 @@ enum Command {
     Check {
         /// The scene file (TOML) or keyword deck (.k, .key, .dyn).
         scene: PathBuf,
+        /// Run the pilot (the scene with K/G capped at 5000, about a third of the run's steps)
+        /// whatever it costs; by default it runs when it costs at most 5e7 element-cycles.
+        #[arg(long, conflicts_with = "no_pilot")]
+        pilot: bool,
+        /// Estimate the steps from the starting step alone.
+        #[arg(long)]
+        no_pilot: bool,
         #[command(flatten)]
         deck: input::DeckArgs,
     },
@@ -180,7 +187,20 @@ pub fn dispatch(cli: Cli) -> Result<(), String> {
             set_threads(threads)?;
             run::run(&scene, &out, quiet, &deck)
         }
-        Command::Check { scene, deck } => check::check(&scene, &deck),
+        Command::Check {
+            scene,
+            pilot,
+            no_pilot,
+            deck,
+        } => check::check(
+            &scene,
+            &deck,
+            match (pilot, no_pilot) {
+                (true, _) => check::Pilot::Always,
+                (_, true) => check::Pilot::Never,
+                _ => check::Pilot::WhenCheap,
+            },
+        ),
         Command::Export(a) => export::export(&a),
         Command::Study {
             quick,

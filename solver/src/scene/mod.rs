@@ -9,6 +9,7 @@ pub mod bulk;
 pub mod contact_spec;
 pub mod def;
 pub mod phantom_spec;
+pub mod pilot;
 pub mod spec;
 
 pub use build::{load_scene, Scene};
