@@ -38,6 +38,7 @@ pub mod error;
 pub mod fit;
 pub mod glyphs;
 pub mod gp;
+pub mod json_f64;
 pub mod kernels;
 pub mod lbfgs;
 pub mod mlp;

@@ -16,6 +16,7 @@ pub struct LocationFit {
     /// Samples scored.
     pub n_samples: usize,
     /// Fit on them (1 perfect, 0 no better than their mean).
+    #[serde(with = "crate::json_f64")]
     pub fit: f64,
 }
 
@@ -43,10 +44,13 @@ pub struct TrainReport {
     pub epochs: Option<usize>,
     /// Final training loss (MLP, normalised mean squared error) or log marginal likelihood per
     /// target (GP).
+    #[serde(with = "crate::json_f64")]
     pub final_objective: f64,
     /// Fit on the training samples.
+    #[serde(with = "crate::json_f64")]
     pub train_fit: f64,
     /// Fit on all test samples pooled (`None` without test samples).
+    #[serde(with = "crate::json_f64::option", default)]
     pub test_fit: Option<f64>,
     /// Fit per test location.
     pub test_fit_by_location: Vec<LocationFit>,

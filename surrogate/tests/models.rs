@@ -429,3 +429,43 @@ fn gp_with_repeated_unloaded_rows_and_noisy_targets_keeps_a_noise_term() {
     assert!(g.kernel.noise_variance > 0.1, "{:?}", g.kernel);
     assert!(report.test_fit.unwrap() > 0.6, "{report}");
 }
+
+#[test]
+fn a_model_whose_fit_is_nan_saves_and_loads() {
+    // One held-out location whose stresses do not vary: its Fit divides by zero (NaN), which
+    // JSON cannot hold. The model used to save with `"fit": null` and then fail to load.
+    let mut d = make_synthetic_dataset(R);
+    let held = (0..d.split.len()).find(|&i| d.split[i] == 1).unwrap();
+    let loc = d.location[held];
+    for i in 0..d.split.len() {
+        if d.location[i] == loc {
+            d.y.row_mut(i).fill(1000.0);
+        }
+    }
+    let (model, report) = train_model(&d, ModelKind::Mlp, &mlp_options(5)).unwrap();
+    let nan = report
+        .test_fit_by_location
+        .iter()
+        .find(|l| l.location == loc)
+        .unwrap();
+    assert!(nan.fit.is_nan(), "{report}");
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("model.safetensors");
+    model
+        .save(
+            &path,
+            d.roi_ids.as_slice().unwrap(),
+            d.roi_centroids.view(),
+            &report,
+        )
+        .unwrap();
+    let loaded = Predictor::load(&path).unwrap();
+    let back = &loaded.meta().report;
+    let fit = |r: &surrogate::report::TrainReport| -> Vec<f64> {
+        r.test_fit_by_location.iter().map(|l| l.fit).collect()
+    };
+    for (a, b) in fit(back).iter().zip(fit(&report)) {
+        assert!(a == &b || (a.is_nan() && b.is_nan()), "{a} against {b}");
+    }
+    assert_eq!(back.train_fit, report.train_fit);
+}
