@@ -202,6 +202,35 @@ fn chain_and_two_shards_merged_equal_one_unsharded_run() {
             "{f}: merged shards differ from the unsharded campaign"
         );
     }
+    merge_into_a_stale_directory_is_refused(tmp.path(), &merged, &s0, &s1);
+}
+
+/// A merge keeps the finished runs it finds in `--out`: into a directory that holds another
+/// campaign, or runs of unknown origin, it is refused before anything is copied.
+fn merge_into_a_stale_directory_is_refused(tmp: &Path, merged: &Path, s0: &Path, s1: &Path) {
+    let other = tmp.join("other");
+    std::fs::create_dir_all(&other).unwrap();
+    let mut v: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(merged.join("campaign.json")).unwrap()).unwrap();
+    let runs = v["plan"]["runs"].as_array_mut().unwrap();
+    runs.pop();
+    std::fs::write(other.join("campaign.json"), v.to_string()).unwrap();
+    let o = palpa(&["campaign", "merge", s(s0), s(s1), "--out", s(&other)]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        !o.status.success() && err.contains("holds another campaign") && err.contains("plan.runs"),
+        "{err}"
+    );
+    assert!(!other.join("runs").exists(), "nothing copied");
+
+    let unknown = tmp.join("unknown");
+    std::fs::create_dir_all(unknown.join("runs").join("P01")).unwrap();
+    let o = palpa(&["campaign", "merge", s(s0), s(s1), "--out", s(&unknown)]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        !o.status.success() && err.contains("holds runs but no campaign.json"),
+        "{err}"
+    );
 }
 
 #[test]

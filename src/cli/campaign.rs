@@ -902,6 +902,7 @@ fn merge(dirs: &[PathBuf], out: &Path, quiet: bool) -> Result<(), String> {
                 .ok_or_else(|| bad_plan("runs.label"))
         })
         .collect::<Result<_, _>>()?;
+    refuse_stale_out(out, &plan, dirs)?;
     std::fs::create_dir_all(out).map_err(|e| format!("{}: {e}", out.display()))?;
     let same = |a: &Path, b: &Path| match (a.canonicalize(), b.canonicalize()) {
         (Ok(x), Ok(y)) => x == y,
@@ -973,6 +974,30 @@ fn merge(dirs: &[PathBuf], out: &Path, quiet: bool) -> Result<(), String> {
             copied
         );
         print_dataset(&ds, out, false);
+    }
+    Ok(())
+}
+
+/// A merge keeps the finished runs it finds in `out`, so `out` must hold this campaign or
+/// nothing: finished runs of another campaign (or of unknown origin) would enter the dataset.
+fn refuse_stale_out(out: &Path, plan: &Value, dirs: &[PathBuf]) -> Result<(), String> {
+    let file = out.join(CAMPAIGN_FILE);
+    if file.is_file() {
+        let v = read_json(&file)?;
+        if v["plan"] != *plan {
+            let diff = first_difference(&v["plan"], plan, "plan").unwrap_or_default();
+            return Err(format!(
+                "merge: {} holds another campaign ({diff}; there = {}, here = {}); merge into an empty directory or one of this campaign's",
+                out.display(),
+                out.display(),
+                dirs[0].display()
+            ));
+        }
+    } else if std::fs::read_dir(run_dir(out, "")).is_ok_and(|mut d| d.next().is_some()) {
+        return Err(format!(
+            "merge: {} holds runs but no {CAMPAIGN_FILE}, so nothing says which campaign they belong to; merge into an empty directory",
+            out.display()
+        ));
     }
     Ok(())
 }
