@@ -169,9 +169,7 @@ fn print_pilot(
         return why_not("--no-pilot");
     }
     if deck {
-        return why_not(
-            "keyword decks keep the starting estimate; a scene written by `palpa export` gets one",
-        );
+        return why_not("a keyword deck keeps the starting estimate");
     }
     let plan = match pilot::plan(path, scene) {
         Ok(p) => p,
