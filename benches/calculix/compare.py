@@ -9,8 +9,8 @@ of every run, and prints per code the marginal rate
 
 (set-up, mesh reading and output cancel in the difference), the same per processor second
 (user + system time of all threads: what other work on a shared machine disturbs least), the
-ratio palpa / CalculiX, and
-the two codes' reactions and bulge at the same times of the 400-increment run. Each run is
+ratio palpa / CalculiX, and the two codes' reactions and bulge at the same times of the
+400-increment run (agreement.py). Each run is
 checked: CalculiX's output blocks must fall at the expected times (one every steps/4
 increments of the fixed increment), palpa's summary.json must report the steps asked for.
 Anything else stops the script with an error.
@@ -60,7 +60,7 @@ def timed(cmd, cwd, env):
     return (wall, cpu), p.stdout
 
 
-def run_ccx(work, n, steps, threads):
+def run_ccx(work, n, steps, threads, tell=False):
     """One CalculiX run: ((wall s, processor s), {(set, time): vector})."""
     d = os.path.join(work, f"ccx{steps}")
     os.makedirs(d, exist_ok=True)
@@ -77,6 +77,9 @@ def run_ccx(work, n, steps, threads):
         fail(f"ccx's stable increment {courant:g} s is below {block.DT:g} s "
              "(it would scale masses)")
     dt = results.ccx_increment(out)
+    if tell:
+        print(f"  ccx {version}: stable (Courant) increment {courant * 1e6:.2f} us, "
+              f"selected {dt * 1e6:.2f} us")
     if abs(dt - block.DT) > 1e-9 * block.DT:
         fail(f"ccx chose the increment {dt:g} s, not {block.DT:g} s")
     dat = results.ccx_dat(os.path.join(d, "block.dat"))
@@ -135,7 +138,7 @@ def main():
     for r in range(a.repeat):
         t = {}
         for steps in (SHORT, LONG):
-            t["ccx", steps], last["ccx", steps] = run_ccx(work, n, steps, a.threads)
+            t["ccx", steps], last["ccx", steps] = run_ccx(work, n, steps, a.threads, tell=r == 0 and steps == SHORT)
         for steps in (SHORT, LONG):
             clock, s, hist, out = run_palpa(work, exe, n, steps, a.threads)
             t["palpa", steps], last["palpa", steps] = clock, (s, hist, out)
