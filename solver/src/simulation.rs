@@ -23,8 +23,8 @@
 
 use crate::bc::{Constraint, Kinematic, NodalLoad};
 use crate::element::{BulkViscosity, StepInput};
-use crate::forces::{element_loop, ElementTotals};
-use crate::model::{Model, SolverError};
+use crate::forces::element_loop;
+use crate::model::{ElementTotals, Model, SolverError};
 use rayon::prelude::*;
 use std::time::{Duration, Instant};
 
