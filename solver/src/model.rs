@@ -68,6 +68,10 @@ pub enum SolverError {
         /// Worst part.
         part: String,
     },
+    /// The run went unstable: non-finite energies, or a negative internal energy (the
+    /// stability guard of [`crate::simulation::Simulation::step`]). The message says when and
+    /// why.
+    Unstable(String),
     /// Any other invalid input.
     Invalid(String),
 }
@@ -92,7 +96,7 @@ impl fmt::Display for SolverError {
                 added_fraction * 100.0,
                 limit * 100.0
             ),
-            SolverError::Invalid(s) => f.write_str(s),
+            SolverError::Unstable(s) | SolverError::Invalid(s) => f.write_str(s),
         }
     }
 }
