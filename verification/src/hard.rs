@@ -30,10 +30,10 @@
 
 use crate::cases::{short, FULL_FBAR, ONE_POINT_VISCOUS_SHEAR};
 use crate::{CaseOutput, Row, Status};
+use contact::Curve;
 use material::neo_hookean::NeoHookean;
 use material::Material;
 use solver::bc::{Constraint, Kinematic};
-use solver::curve::Curve;
 use solver::element::Formulation;
 use solver::generate::{box_mesh, BoxSpec};
 use solver::mesh::Mesh;
@@ -237,7 +237,7 @@ pub fn flesh_compression(form: Formulation) -> Result<HardRun, String> {
     c.push(disp(
         &ns["zmax"],
         2,
-        Curve::SmoothStep {
+        Curve::SmoothStepBetween {
             t0: 0.0,
             t1: 0.02,
             from: 0.0,
@@ -260,7 +260,7 @@ pub fn liver_stretches() -> Result<HardRun, String> {
         disp(
             &ns["zmax"],
             2,
-            Curve::Table(vec![(0.0, 0.0), (0.1, -0.5 * h), (0.2, 0.6 * h)]),
+            Curve::Polyline(vec![(0.0, 0.0), (0.1, -0.5 * h), (0.2, 0.6 * h)]),
         ),
     ];
     let mut s = sim(m, library("paper:liver"), ONE_POINT_VISCOUS_SHEAR, c)?;
@@ -284,7 +284,7 @@ pub fn ribs_bending() -> Result<(HardRun, f64), String> {
     c.push(disp(
         &mid,
         2,
-        Curve::SmoothStep {
+        Curve::SmoothStepBetween {
             t0: 0.0,
             t1: 0.02,
             from: 0.0,
@@ -320,7 +320,7 @@ pub fn inversion() -> Result<HardRun, String> {
         c.push(disp(
             &[corner],
             d,
-            Curve::SmoothStep {
+            Curve::SmoothStepBetween {
                 t0: 0.0,
                 t1: 0.01,
                 from: 0.0,
@@ -394,7 +394,7 @@ pub fn liver_negative_poisson_block() -> Result<(HardRun, f64), String> {
         disp(
             &ns["zmax"],
             2,
-            Curve::SmoothStep {
+            Curve::SmoothStepBetween {
                 t0: 0.0,
                 t1: 0.002,
                 from: 0.0,

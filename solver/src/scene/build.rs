@@ -5,13 +5,13 @@ use super::contact_spec::HandScene;
 use super::def::{DtMin, HourglassGuard, PartDef, SceneDef, Setup};
 use super::spec::*;
 use crate::bc::{Constraint, Kinematic, NodalLoad};
-use crate::curve::Curve;
 use crate::element::{BulkViscosity, Formulation, Hourglass, HourglassForm, HourglassModulus};
 use crate::generate::{box_mesh, BoxSpec};
 use crate::mesh::Mesh;
 use crate::model::MassScaling;
 use crate::phantom::Phantom;
 use crate::simulation::{DynamicRelaxation, Simulation};
+use contact::Curve;
 use material::quantity::Length;
 use material::Material;
 use std::path::{Path, PathBuf};
@@ -109,13 +109,15 @@ fn axis(s: &str) -> Option<usize> {
 /// Convert a curve spec, with values already in SI through their typed unit.
 pub fn curve<Q: Copy + Into<f64>>(c: &CurveSpec<Q>) -> Result<Curve, String> {
     let cv = match c {
-        CurveSpec::Constant { value } => Curve::Constant((*value).into()),
+        CurveSpec::Constant { value } => Curve::Constant {
+            value: (*value).into(),
+        },
         CurveSpec::SmoothStep {
             value,
             from,
             start,
             end,
-        } => Curve::SmoothStep {
+        } => Curve::SmoothStepBetween {
             t0: start.map(|t| t.0).unwrap_or(0.0),
             t1: end.0,
             from: from.map(|f| f.into()).unwrap_or(0.0),
@@ -123,7 +125,7 @@ pub fn curve<Q: Copy + Into<f64>>(c: &CurveSpec<Q>) -> Result<Curve, String> {
         },
         CurveSpec::Ramp { value, start, end } => {
             let t0 = start.map(|t| t.0).unwrap_or(0.0);
-            Curve::Table(vec![(t0, 0.0), (end.0, (*value).into())])
+            Curve::Polyline(vec![(t0, 0.0), (end.0, (*value).into())])
         }
         CurveSpec::Table { time, value } => {
             if time.len() != value.len() {
@@ -133,7 +135,7 @@ pub fn curve<Q: Copy + Into<f64>>(c: &CurveSpec<Q>) -> Result<Curve, String> {
                     value.len()
                 ));
             }
-            Curve::Table(
+            Curve::Polyline(
                 time.iter()
                     .zip(value)
                     .map(|(t, v)| (t.0, (*v).into()))
@@ -622,8 +624,9 @@ pub fn resolve_scene(
         };
         for (a, c) in [&l.force.x, &l.force.y, &l.force.z].into_iter().enumerate() {
             if let Some(c) = c {
-                let mut cv = curve(c).map_err(|m| e(&format!("{key}.force"), Some("force"), &m))?;
-                scale_curve(&mut cv, share);
+                let cv = curve(c)
+                    .map_err(|m| e(&format!("{key}.force"), Some("force"), &m))?
+                    .scaled(share);
                 loads.push(NodalLoad {
                     nodes: nodes.clone(),
                     dof: a,
@@ -899,15 +902,4 @@ fn place_hand(h: &mut HandScene, phantom: Option<&Phantom>) -> Result<(), String
         h.direction = Some(loc.inward_normal);
     }
     Ok(())
-}
-
-fn scale_curve(c: &mut Curve, s: f64) {
-    match c {
-        Curve::Constant(v) => *v *= s,
-        Curve::Table(p) => p.iter_mut().for_each(|x| x.1 *= s),
-        Curve::SmoothStep { from, to, .. } => {
-            *from *= s;
-            *to *= s;
-        }
-    }
 }
