@@ -21,8 +21,7 @@ pub mod spec;
 pub mod tensor;
 
 pub use law::{Law, LawError, Mat3, Response};
-pub use library::named;
-pub use spec::MaterialSpec;
+pub use spec::{named, MaterialSpec};
 
 /// Every law palpa knows, as plain parameter data.
 #[derive(Clone, Debug)]

@@ -497,7 +497,7 @@ pub fn resolve_scene(
                 )
             })?,
             None if material::library::is_library_name(&ps.material) => {
-                material::library::named(&ps.material)
+                material::named(&ps.material)
                     .and_then(|c| c.build_in(&ps.material, base))
                     .map_err(|m| e(&format!("{key}.material"), Some(&ps.material), &m))?
             }
@@ -517,7 +517,7 @@ pub fn resolve_scene(
             formulation(ps).map_err(|m| e(&key, Some(&format!("\"{pname}\"")), &m))?;
         let card = match spec.materials.get(&ps.material) {
             Some(card) => card.clone(),
-            None => material::library::named(&ps.material)
+            None => material::named(&ps.material)
                 .map_err(|m| e(&format!("{key}.material"), Some(&ps.material), &m))?,
         };
         let (material, card, bulk) = bulk_knob(ps, material, card)
