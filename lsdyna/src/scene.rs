@@ -45,10 +45,8 @@ use solver::bc::{Constraint, Kinematic, NodalLoad};
 use solver::element::{BulkViscosity, Formulation, Hourglass, HourglassForm, HourglassModulus};
 use solver::mesh::Mesh;
 use solver::model::{MassScaling, StepTarget};
-use solver::scene::build::OutputPlan;
-use solver::scene::def::{
-    ContactDef, DtMin, HourglassGuard, IndenterDef, PartDef, SceneDef, Setup, SurfaceSel,
-};
+use solver::scene::contact_def::{ContactDef, IndenterDef, SurfaceSel};
+use solver::scene::def::{DtMin, HourglassGuard, OutputPlan, PartDef, SceneDef, Setup};
 use solver::simulation::DynamicRelaxation;
 use std::collections::{BTreeMap, HashMap, HashSet};
 use std::path::{Path, PathBuf};
