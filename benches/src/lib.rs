@@ -1,10 +1,10 @@
 //! Shared set-up for palpa's benchmarks: the standard 100k-element neo-Hookean block.
 #![warn(missing_docs)]
 
+use contact::Curve;
 use material::neo_hookean::NeoHookean;
 use material::Material;
 use solver::bc::{Constraint, Kinematic};
-use solver::curve::Curve;
 use solver::element::{Formulation, Hourglass};
 use solver::generate::{box_mesh, BoxSpec};
 use solver::model::{Model, Part};
@@ -43,7 +43,7 @@ pub fn block_simulation(n: [usize; 3], formulation: Formulation) -> Simulation {
         Constraint {
             nodes: top,
             dof: 2,
-            kind: Kinematic::Velocity(Curve::Constant(-0.5)),
+            kind: Kinematic::Velocity(Curve::Constant { value: -0.5 }),
         },
     ];
     Simulation::new(

@@ -8,8 +8,9 @@
 
 use serde::Deserialize;
 
+use crate::aabb::Aabb;
 use crate::motion::{MotionSpec, MotionState};
-use crate::shape::{Aabb, Shape, ShapeSpec};
+use crate::shape::{Shape, ShapeSpec};
 use crate::vec3::*;
 use crate::ContactError;
 

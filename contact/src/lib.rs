@@ -9,9 +9,13 @@
 //! - [`shape`]: analytic rigid shapes (sphere, capsule, cylinder, box, plane) with exact signed
 //!   distances; [`trimesh`]: STL triangle meshes with a BVH and pseudo-normal signs;
 //!   [`tessellate`]: quadrilateral surfaces and hollow hexahedral meshes of the analytic shapes.
+//! - [`aabb`]: axis-aligned bounding boxes, for the shapes' bounds, the mesh's BVH and the
+//!   contact stage's broad phase.
 //! - [`indenter`]: indenters (unions of parts moving along a direction) and the two-finger
 //!   [`HandSpec`] preset.
-//! - [`motion`]: prescribed displacement/velocity curves and force control.
+//! - [`curve`]: curves of time ([`Curve`]), for an indenter's motion and for the solver's
+//!   boundary conditions.
+//! - [`motion`]: prescribed displacement/velocity and force control.
 //! - [`stage`]: the penalty contact stage ([`ContactStage`]): sampled surface-to-surface penalty,
 //!   segment-based or soft stiffness, friction, broad phase, energy and time-step bound. The
 //!   equations and their sources are in that module's doc.
@@ -47,6 +51,8 @@
 // `!(x > 0.0)` is deliberate throughout: it also rejects NaN.
 #![allow(clippy::neg_cmp_op_on_partial_ord)]
 
+pub mod aabb;
+pub mod curve;
 pub mod indenter;
 pub mod motion;
 pub mod shape;
@@ -55,9 +61,11 @@ pub mod tessellate;
 pub mod trimesh;
 mod vec3;
 
+pub use aabb::Aabb;
+pub use curve::Curve;
 pub use indenter::{HandSpec, Indenter, IndenterSpec, IndenterState};
-pub use motion::{Curve, ForceControl, MotionSpec};
-pub use shape::{Aabb, Shape, ShapeSpec};
+pub use motion::{ForceControl, MotionSpec};
+pub use shape::{Shape, ShapeSpec};
 pub use stage::{ContactParams, ContactStage, ContactSurface, PenaltyKind, RayHit};
 pub use trimesh::TriMesh;
 

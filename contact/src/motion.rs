@@ -3,7 +3,9 @@
 //! An indenter translates along its unit pressing direction `d`; its offset from the initial
 //! placement is `u(t) = s(t) d`, with `s` the travel (m).
 //!
-//! **Curves** ([`Curve`]) give a scalar of time:
+//! **Curves** ([`Curve`], see [`crate::curve`]) give a scalar of time; a motion's curve is one
+//! of the forms a motion file may write (`curve = "smooth_step"`, `"ramp"`, `"table"`,
+//! `"constant"`):
 //! - `smooth_step`: `a * S((t - t0) / T)` with the quintic `S(r) = 10 r^3 - 15 r^4 + 6 r^5`
 //!   (`S(0) = 0`, `S(1) = 1`, zero velocity and acceleration at both ends; peak rate
 //!   `1.875 a / T`), held at `a` after `t0 + T`. "15 mm in 25 ms" is
@@ -42,144 +44,8 @@
 //! stiffness hourglass control or the F-bar element (`solver/tests/contact_force_control.rs`
 //! measures both, and checks that the depth holds still).
 
+use crate::curve::Curve;
 use serde::Deserialize;
-
-/// A scalar function of time (value unit set by its use: m, m/s).
-#[derive(Clone, Debug, Deserialize, PartialEq)]
-#[serde(tag = "curve", rename_all = "snake_case", deny_unknown_fields)]
-pub enum Curve {
-    /// Quintic smooth step from 0 to `amplitude` over `[start, start + duration]`, then held.
-    SmoothStep {
-        /// Final value.
-        amplitude: f64,
-        /// Duration of the transition (s).
-        duration: f64,
-        /// Start time (s). Default 0.
-        #[serde(default)]
-        start: f64,
-    },
-    /// Linear ramp from 0 to `amplitude` over `[start, start + duration]`, then held.
-    Ramp {
-        /// Final value.
-        amplitude: f64,
-        /// Duration of the ramp (s).
-        duration: f64,
-        /// Start time (s). Default 0.
-        #[serde(default)]
-        start: f64,
-    },
-    /// Piecewise linear through `[t (s), value]` points (sorted by time), held outside.
-    Table {
-        /// `[time (s), value]` pairs, increasing in time.
-        points: Vec<[f64; 2]>,
-    },
-    /// A constant value.
-    Constant {
-        /// The value.
-        value: f64,
-    },
-}
-
-impl Curve {
-    /// Value at time `t` (s).
-    pub fn value(&self, t: f64) -> f64 {
-        match self {
-            Curve::SmoothStep {
-                amplitude,
-                duration,
-                start,
-            } => {
-                let r = ((t - start) / duration).clamp(0.0, 1.0);
-                amplitude * r * r * r * (10.0 + r * (-15.0 + 6.0 * r))
-            }
-            Curve::Ramp {
-                amplitude,
-                duration,
-                start,
-            } => amplitude * ((t - start) / duration).clamp(0.0, 1.0),
-            Curve::Table { points } => table(points, t).0,
-            Curve::Constant { value } => *value,
-        }
-    }
-
-    /// Time derivative at `t` (unit of the value per s).
-    pub fn rate(&self, t: f64) -> f64 {
-        match self {
-            Curve::SmoothStep {
-                amplitude,
-                duration,
-                start,
-            } => {
-                let r = (t - start) / duration;
-                if !(0.0..=1.0).contains(&r) {
-                    return 0.0;
-                }
-                amplitude / duration * 30.0 * r * r * (1.0 - r) * (1.0 - r)
-            }
-            Curve::Ramp {
-                amplitude,
-                duration,
-                start,
-            } => {
-                if t >= *start && t <= start + duration {
-                    amplitude / duration
-                } else {
-                    0.0
-                }
-            }
-            Curve::Table { points } => table(points, t).1,
-            Curve::Constant { .. } => 0.0,
-        }
-    }
-
-    pub(crate) fn validate(&self) -> Result<(), String> {
-        match self {
-            Curve::SmoothStep {
-                duration,
-                amplitude,
-                start,
-            }
-            | Curve::Ramp {
-                duration,
-                amplitude,
-                start,
-            } => {
-                if !(*duration > 0.0) || !amplitude.is_finite() || !start.is_finite() {
-                    return Err("curve needs a positive duration and finite amplitude".into());
-                }
-            }
-            Curve::Table { points } => {
-                if points.is_empty() {
-                    return Err("table curve has no points".into());
-                }
-                if points.windows(2).any(|w| !(w[1][0] > w[0][0])) {
-                    return Err("table curve times must increase strictly".into());
-                }
-            }
-            Curve::Constant { value } => {
-                if !value.is_finite() {
-                    return Err("constant curve is not finite".into());
-                }
-            }
-        }
-        Ok(())
-    }
-}
-
-fn table(points: &[[f64; 2]], t: f64) -> (f64, f64) {
-    let n = points.len();
-    if t <= points[0][0] {
-        return (points[0][1], 0.0);
-    }
-    if t >= points[n - 1][0] {
-        return (points[n - 1][1], 0.0);
-    }
-    // Binary search for the segment.
-    let i = points.partition_point(|p| p[0] <= t) - 1;
-    let (a, b) = (points[i], points[i + 1]);
-    let slope = (b[1] - a[1]) / (b[0] - a[0]);
-    (a[1] + slope * (t - a[0]), slope)
-}
 
 /// Force-control parameters (SI). See the module doc for the law.
 #[derive(Clone, Debug, Deserialize, PartialEq)]
@@ -251,7 +117,14 @@ impl MotionSpec {
     pub(crate) fn validate(&self) -> Result<(), String> {
         match self {
             MotionSpec::Fixed => Ok(()),
-            MotionSpec::Displacement { curve } | MotionSpec::Velocity { curve } => curve.validate(),
+            MotionSpec::Displacement { curve } | MotionSpec::Velocity { curve } => {
+                if let Curve::Constant { value } = curve {
+                    if !value.is_finite() {
+                        return Err("constant curve is not finite".into());
+                    }
+                }
+                curve.validate()
+            }
             MotionSpec::Force(f) => {
                 let ok = f.target.is_finite()
                     && f.ramp_time >= 0.0

@@ -74,8 +74,8 @@
 
 use serde::Deserialize;
 
+use crate::aabb::Aabb;
 use crate::indenter::{Indenter, IndenterSpec, IndenterState};
-use crate::shape::Aabb;
 use crate::vec3::*;
 use crate::ContactError;
 

@@ -23,7 +23,7 @@
 use std::collections::HashMap;
 use std::path::Path;
 
-use crate::shape::Aabb;
+use crate::aabb::Aabb;
 use crate::vec3::*;
 use crate::ContactError;
 

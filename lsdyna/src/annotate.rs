@@ -60,7 +60,7 @@ pub fn take<T: for<'de> Deserialize<'de>>(
     }
 }
 
-/// A boundary curve of a scene ([`solver::curve::Curve`]) in a comment.
+/// A boundary curve of a scene ([`contact::Curve`]) in a comment.
 #[derive(Clone, Debug, Deserialize, PartialEq)]
 #[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
 pub enum BcCurve {
@@ -79,10 +79,10 @@ pub enum BcCurve {
 
 impl BcCurve {
     /// The solver's curve.
-    pub fn to_curve(&self) -> solver::curve::Curve {
+    pub fn to_curve(&self) -> contact::Curve {
         match *self {
             BcCurve::SmoothStep { t0, t1, from, to } => {
-                solver::curve::Curve::SmoothStep { t0, t1, from, to }
+                contact::Curve::SmoothStepBetween { t0, t1, from, to }
             }
         }
     }

@@ -5,7 +5,7 @@
 //! Reals follow Fortran's list input as LS-DYNA reads it: `1.5`, `1.`, `.5`, `1.5e-3`,
 //! `1.5E-3`, `1.5d-3`. Integers may not have a decimal point.
 
-use crate::lex::{Block, Card, Format, Loc};
+use crate::lex::{parse_real, Block, Card, Format, Loc};
 
 /// A field of a card layout: its name and standard width in columns.
 pub type Field = (&'static str, usize);
@@ -134,16 +134,6 @@ pub fn fields(
         values,
         cols,
     })
-}
-
-/// Parse a real as LS-DYNA does.
-pub fn parse_real(s: &str) -> Option<f64> {
-    let t = s.trim();
-    if t.is_empty() {
-        return None;
-    }
-    let t = t.replace(['d', 'D'], "e");
-    t.parse::<f64>().ok().filter(|v| v.is_finite())
 }
 
 impl Fields {

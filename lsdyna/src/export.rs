@@ -34,11 +34,10 @@
 
 use crate::units::Units;
 use contact::tessellate::{self as shapes, HexMesh};
-use contact::{Curve as MCurve, MotionSpec, PenaltyKind, ShapeSpec};
+use contact::{Curve, MotionSpec, PenaltyKind, ShapeSpec};
 use material::quantity::Dim;
 use material::{Material, MaterialSpec};
 use solver::bc::Kinematic;
-use solver::curve::Curve;
 use solver::element::{Formulation, HourglassForm, HourglassModulus};
 use solver::model::StepTarget;
 use solver::scene::def::DtMin;
@@ -516,11 +515,17 @@ pub fn export(scene: &Scene, opts: &ExportOptions) -> Result<Exported, String> {
         }
         p
     };
+    // A scene's boundary curves take the boundary forms (constant, polyline, smooth step
+    // between two values); a motion's forms, which a scene never gives a boundary, are
+    // written as their points without a comment.
     let bc_points = |c: &Curve| -> (Vec<(f64, f64)>, Option<(String, String)>) {
         match c {
-            Curve::Constant(v) => (vec![(0.0, *v), (end, *v)], None),
-            Curve::Table(p) => (p.clone(), None),
-            Curve::SmoothStep { t0, t1, from, to } => (
+            Curve::Constant { value: v } => (vec![(0.0, *v), (end, *v)], None),
+            Curve::Polyline(p) => (p.clone(), None),
+            Curve::SmoothStep { .. } | Curve::Ramp { .. } | Curve::Table { .. } => {
+                (motion_points(c, end, 1.0, &sample).0, None)
+            }
+            Curve::SmoothStepBetween { t0, t1, from, to } => (
                 sample(*t0, *t1, &|t| c.value(t)),
                 Some((
                     "curve".into(),
@@ -1438,22 +1443,25 @@ fn shape_toml(s: &ShapeSpec) -> String {
 /// An indenter's motion curve as points (the direction's `sign` along an axis) and the exact
 /// curve as a comment.
 fn motion_points(
-    c: &MCurve,
+    c: &Curve,
     end: f64,
     sign: f64,
     sample: &dyn Fn(f64, f64, &dyn Fn(f64) -> f64) -> Vec<(f64, f64)>,
 ) -> (Vec<(f64, f64)>, Option<(String, String)>) {
     let note = |s: String| Some(("motion".to_string(), s));
     let (pts, n) = match c {
-        MCurve::Table { points } => (points.iter().map(|p| (p[0], p[1])).collect(), None),
-        MCurve::Constant { value } => (
+        Curve::Table { points } => (points.iter().map(|p| (p[0], p[1])).collect(), None),
+        // the boundary forms, which no motion takes: their points, without a comment
+        Curve::Polyline(p) => (p.clone(), None),
+        Curve::SmoothStepBetween { t0, t1, .. } => (sample(*t0, *t1, &|t| c.value(t)), None),
+        Curve::Constant { value } => (
             vec![(0.0, *value), (end, *value)],
             note(format!(
                 "{{ curve = \"constant\", value = {} }}",
                 tn(*value)
             )),
         ),
-        MCurve::SmoothStep {
+        Curve::SmoothStep {
             amplitude,
             duration,
             start,
@@ -1466,7 +1474,7 @@ fn motion_points(
                 tn(*start)
             )),
         ),
-        MCurve::Ramp {
+        Curve::Ramp {
             amplitude,
             duration,
             start,

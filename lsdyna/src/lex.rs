@@ -13,6 +13,7 @@
 //! `*INCLUDE_PATH` directories); `*END` ends the file it is in. A comment line that starts with
 //! `$palpa:` carries data that only palpa reads (see [`crate::annotate`]); LS-DYNA skips it.
 
+use std::collections::BTreeMap;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
@@ -78,7 +79,22 @@ pub struct Block {
     /// `$palpa:` comments inside the keyword: (where, text after `$palpa:`).
     pub palpa: Vec<(Loc, String)>,
     /// The `*PARAMETER` values defined before this keyword.
-    pub params: Arc<crate::params::Params>,
+    pub params: Arc<Params>,
+}
+
+/// Parameters in effect: upper-case name -> (value text, where it was defined), see
+/// [`crate::params`].
+pub type Params = BTreeMap<String, (String, Loc)>;
+
+/// Parse a real as LS-DYNA does (Fortran list input: `1.5`, `1.`, `.5`, `1.5e-3`, `1.5d-3`);
+/// `None` for a blank, malformed or non-finite field.
+pub fn parse_real(s: &str) -> Option<f64> {
+    let t = s.trim();
+    if t.is_empty() {
+        return None;
+    }
+    let t = t.replace(['d', 'D'], "e");
+    t.parse::<f64>().ok().filter(|v| v.is_finite())
 }
 
 /// Every keyword of a deck and its included files, in reading order.
@@ -92,12 +108,12 @@ pub struct Lexed {
     pub header_palpa: Vec<(Loc, String)>,
 }
 
-/// Read a deck and its includes.
+/// Read a deck and its includes (the `*PARAMETER` values are given to the blocks after,
+/// by [`crate::params::expand`]).
 pub fn read(path: &Path) -> Result<Lexed, String> {
     let mut out = Lexed::default();
     let mut search: Vec<PathBuf> = Vec::new();
     read_file(path, None, &mut out, &mut search, Format::Standard, 0)?;
-    crate::params::expand(&mut out)?;
     Ok(out)
 }
 

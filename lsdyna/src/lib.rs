@@ -46,10 +46,12 @@ pub fn is_deck(path: &Path) -> bool {
 
 /// Read a deck (and its includes) into a resolved scene.
 pub fn read_deck(path: &Path, opts: &ReadOptions) -> Result<(SceneDef, Report), DeckError> {
-    let lexed = lex::read(path).map_err(|e| DeckError {
-        errors: vec![e],
-        warnings: Vec::new(),
-    })?;
+    let lexed = lex::read(path)
+        .and_then(|mut l| params::expand(&mut l).map(|()| l))
+        .map_err(|e| DeckError {
+            errors: vec![e],
+            warnings: Vec::new(),
+        })?;
     let deck = keywords::parse(&lexed);
     scene::to_scene(&deck, path, &lexed.files, opts)
 }

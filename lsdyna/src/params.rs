@@ -8,12 +8,8 @@
 //! `*PARAMETER_EXPRESSION` (values computed from formulas) is not evaluated: the keyword reader
 //! refuses it.
 
-use crate::lex::{Card, Lexed, Loc};
-use std::collections::BTreeMap;
+use crate::lex::{parse_real, Card, Lexed, Params};
 use std::sync::Arc;
-
-/// Parameters in effect: upper-case name -> (value text, where it was defined).
-pub type Params = BTreeMap<String, (String, Loc)>;
 
 /// Read the `*PARAMETER` keywords and give every later keyword the parameters then defined.
 pub fn expand(lexed: &mut Lexed) -> Result<(), String> {
@@ -84,7 +80,7 @@ fn pairs(card: &Card, kw: &str) -> Result<Vec<(String, String)>, String> {
             ));
         }
         match ty {
-            'R' if crate::card::parse_real(&value).is_none() => {
+            'R' if parse_real(&value).is_none() => {
                 return Err(format!(
                     "{}: *{kw}: real parameter `{name}`: `{value}` is not a number",
                     card.at

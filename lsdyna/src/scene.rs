@@ -36,20 +36,17 @@ use crate::annotate::{self, BcCurve, ElementNote, RelaxationNote, RunNote};
 use crate::keywords::{ContactCard, CurveCard, Deck, Key, MatCard, MatKind, PartCard, Target};
 use crate::lex::Loc;
 use crate::units::Units;
-use contact::{ContactParams, IndenterSpec, MotionSpec, PenaltyKind, ShapeSpec};
+use contact::{ContactParams, Curve, IndenterSpec, MotionSpec, PenaltyKind, ShapeSpec};
 use material::quantity::{Density, Dim, Number, Pressure, Rate};
 use material::spec::{FoamSpec, IsotropicSpec, OgdenSpec, PlasticitySpec, PronySpec};
 use material::{Material, MaterialSpec};
 use serde::Deserialize;
 use solver::bc::{Constraint, Kinematic, NodalLoad};
-use solver::curve::Curve;
 use solver::element::{BulkViscosity, Formulation, Hourglass, HourglassForm, HourglassModulus};
 use solver::mesh::Mesh;
 use solver::model::{MassScaling, StepTarget};
-use solver::scene::build::OutputPlan;
-use solver::scene::def::{
-    ContactDef, DtMin, HourglassGuard, IndenterDef, PartDef, SceneDef, Setup, SurfaceSel,
-};
+use solver::scene::contact_def::{ContactDef, IndenterDef, SurfaceSel};
+use solver::scene::def::{DtMin, HourglassGuard, OutputPlan, PartDef, SceneDef, Setup};
 use solver::simulation::DynamicRelaxation;
 use std::collections::{BTreeMap, HashMap, HashSet};
 use std::path::{Path, PathBuf};
@@ -226,7 +223,7 @@ impl Ctx<'_> {
                 "{cat}: `$palpa: curve` does not match the points of *DEFINE_CURVE {lcid}; the table is used"
             ));
         }
-        let cv = Curve::Table(pts);
+        let cv = Curve::Polyline(pts);
         cv.validate().map_err(|m| format!("{cat}: {m}"))?;
         Ok(cv)
     }
@@ -780,7 +777,7 @@ fn build(cx: &mut Ctx, path: &Path) -> Result<SceneDef, Vec<String>> {
                 let cv = if s == 1.0 {
                     base.clone()
                 } else {
-                    scale_curve(&base, s)
+                    base.scaled(s)
                 };
                 constraints.push(Constraint {
                     nodes: nodes.clone(),
@@ -1178,19 +1175,6 @@ fn build(cx: &mut Ctx, path: &Path) -> Result<SceneDef, Vec<String>> {
         },
         notes: Vec::new(),
     })
-}
-
-fn scale_curve(c: &Curve, s: f64) -> Curve {
-    match c {
-        Curve::Constant(v) => Curve::Constant(v * s),
-        Curve::Table(p) => Curve::Table(p.iter().map(|&(t, v)| (t, v * s)).collect()),
-        Curve::SmoothStep { t0, t1, from, to } => Curve::SmoothStep {
-            t0: *t0,
-            t1: *t1,
-            from: from * s,
-            to: to * s,
-        },
-    }
 }
 
 fn vector(d: &Deck, vid: Option<i64>, at: &str) -> Result<[f64; 3], String> {

@@ -36,8 +36,9 @@
 //! the cumulative `dissipated` energy, `failed` (0/1), then the law's history values by name
 //! (e.g. `eps_p` for plasticity). The first row is the undeformed state at t = 0.
 
-use crate::law::{cauchy_from_pk2, Law, LawError, Mat3, Response};
+use crate::law::{cauchy_from_pk2, Law, LawError, Response};
 use crate::quantity::{Number, Rate, Time};
+use crate::tensor::Mat3;
 use crate::{with_law, MaterialSpec};
 use serde::Deserialize;
 use std::path::Path;

@@ -419,7 +419,8 @@ fn damped_wave_speed<R: Real>(m: R, d: R, rho: f64) -> R {
 mod tests {
     use super::*;
     #[allow(unused_imports)]
-    use crate::law::{LawError, Mat3};
+    use crate::law::LawError;
+    use crate::tensor::Mat3;
     use nalgebra::Vector3;
 
     fn flesh() -> Foam {

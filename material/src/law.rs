@@ -22,12 +22,8 @@
 
 use crate::principal::Sym6;
 use crate::real::Real;
-use crate::tensor::{from_mat3, to_mat3, M3};
-use nalgebra::Matrix3;
+use crate::tensor::{from_mat3, to_mat3, Mat3, M3};
 use thiserror::Error;
-
-/// 3x3 matrix of f64 (deformation gradient, stresses).
-pub type Mat3 = Matrix3<f64>;
 
 /// What a law returns for one integration point and one step.
 #[derive(Clone, Copy, Debug)]

@@ -20,9 +20,9 @@ pub mod real;
 pub mod spec;
 pub mod tensor;
 
-pub use law::{Law, LawError, Mat3, Response};
-pub use library::named;
-pub use spec::MaterialSpec;
+pub use law::{Law, LawError, Response};
+pub use spec::{named, MaterialSpec};
+pub use tensor::Mat3;
 
 /// Every law palpa knows, as plain parameter data.
 #[derive(Clone, Debug)]

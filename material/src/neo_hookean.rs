@@ -73,7 +73,8 @@ impl Law for NeoHookean {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::law::{LawError, Mat3};
+    use crate::law::LawError;
+    use crate::tensor::Mat3;
     use nalgebra::Rotation3;
 
     fn law() -> NeoHookean {

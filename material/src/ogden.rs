@@ -467,7 +467,8 @@ impl Law for Ogden {
 mod tests {
     use super::*;
     #[allow(unused_imports)]
-    use crate::law::{LawError, Mat3};
+    use crate::law::LawError;
+    use crate::tensor::Mat3;
     use nalgebra::{Rotation3, Vector3};
 
     const MU: [f64; 3] = [89.14, 9.965, -92.75];

@@ -333,7 +333,8 @@ impl Law for Plasticity {
 mod tests {
     use super::*;
     #[allow(unused_imports)]
-    use crate::law::{LawError, Mat3};
+    use crate::law::LawError;
+    use crate::tensor::Mat3;
     use nalgebra::{Rotation3, Vector3};
 
     fn ribs() -> Plasticity {

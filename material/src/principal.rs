@@ -29,9 +29,8 @@
 //! Symmetric tensors are stored as `[xx, yy, zz, xy, yz, zx]` (the "Sym6" order used for
 //! history values and output columns).
 
-use crate::law::Mat3;
 use crate::real::{Mask, Real};
-use crate::tensor::M3;
+use crate::tensor::{Mat3, M3};
 
 /// Symmetric tensor in the order `[xx, yy, zz, xy, yz, zx]`.
 pub type Sym6<R = f64> = [R; 6];

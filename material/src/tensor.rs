@@ -2,8 +2,11 @@
 //! `m[i][j]`. The kernels need only these few operations, each written out so that the scalar
 //! and the batched instantiation perform the same arithmetic in the same order.
 
-use crate::law::Mat3;
 use crate::real::Real;
+use nalgebra::Matrix3;
+
+/// 3x3 matrix of f64 (deformation gradient, stresses).
+pub type Mat3 = Matrix3<f64>;
 
 /// A 3x3 matrix over `R`, row-major.
 pub type M3<R> = [[R; 3]; 3];

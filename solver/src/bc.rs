@@ -7,7 +7,7 @@
 //!   R = m a - (f_ext - f_int),
 //! with a the acceleration the constraint imposed.
 
-use crate::curve::Curve;
+use contact::Curve;
 
 /// What a kinematic condition prescribes on one degree of freedom.
 #[derive(Clone, Debug, PartialEq)]

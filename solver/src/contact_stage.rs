@@ -44,11 +44,10 @@
 
 use crate::mesh::Mesh;
 use crate::output::vtk::RigidSurface;
+use crate::scene::contact_def::{ContactDef, HandDef, IndenterDef, SurfaceSel};
 use crate::scene::contact_spec::{
     ContactScene, HandScene, IndenterScene, MotionScene, ShapeScene, DEFAULT_SOFT_SCALE,
 };
-use crate::scene::def::{ContactDef, HandDef, IndenterDef, SurfaceSel};
-use crate::scene::spec::CurveSpec;
 use crate::simulation::{ForceStage, Simulation};
 use contact::{
     ContactParams, ContactStage, ContactSurface, Curve, ForceControl, HandSpec, IndenterSpec,
@@ -295,62 +294,14 @@ fn shape(s: &ShapeScene, base: &Path) -> ShapeSpec {
     }
 }
 
-fn motion_curve<Q: Copy + Into<f64>>(c: &CurveSpec<Q>) -> Result<Curve, String> {
-    Ok(match c {
-        CurveSpec::Constant { value } => Curve::Constant {
-            value: (*value).into(),
-        },
-        CurveSpec::SmoothStep {
-            value,
-            from,
-            start,
-            end,
-        } => {
-            if from.is_some_and(|f| Into::<f64>::into(f) != 0.0) {
-                return Err("an indenter's smooth_step starts from 0 (drop `from`)".into());
-            }
-            let t0 = start.map_or(0.0, |t| t.0);
-            Curve::SmoothStep {
-                amplitude: (*value).into(),
-                duration: end.0 - t0,
-                start: t0,
-            }
-        }
-        CurveSpec::Ramp { value, start, end } => {
-            let t0 = start.map_or(0.0, |t| t.0);
-            Curve::Ramp {
-                amplitude: (*value).into(),
-                duration: end.0 - t0,
-                start: t0,
-            }
-        }
-        CurveSpec::Table { time, value } => {
-            if time.len() != value.len() {
-                return Err(format!(
-                    "table has {} times but {} values",
-                    time.len(),
-                    value.len()
-                ));
-            }
-            Curve::Table {
-                points: time
-                    .iter()
-                    .zip(value)
-                    .map(|(t, v)| [t.0, (*v).into()])
-                    .collect(),
-            }
-        }
-    })
-}
-
 fn motion(m: &MotionScene) -> Result<MotionSpec, String> {
     Ok(match m {
         MotionScene::Fixed => MotionSpec::Fixed,
         MotionScene::Displacement { curve } => MotionSpec::Displacement {
-            curve: motion_curve(curve)?,
+            curve: curve.motion_curve()?,
         },
         MotionScene::Velocity { curve } => MotionSpec::Velocity {
-            curve: motion_curve(curve)?,
+            curve: curve.motion_curve()?,
         },
         MotionScene::Force {
             target,

@@ -21,42 +21,17 @@
 //! results are bitwise identical on 1 or N threads. This replaced a per-element force buffer
 //! summed by a node-to-element gather table, which moved 384 bytes per element and cycle more and
 //! cost about a third of the step on the 100k-element blocks of `palpa bench` (the gather's loads
-//! were cache misses 512 bytes apart). Chunk partial results (minimum step, energy rates) are
-//! reduced serially in chunk order, and inside a chunk element by element in element order, for
-//! the same reason.
+//! were cache misses 512 bytes apart). Chunk partial results (minimum step, energy rates: one
+//! [`ElementTotals`] per chunk) are reduced serially in chunk order, and inside a chunk element
+//! by element in element order, both by [`ElementTotals::combine`], for the same reason.
 
 use crate::element::physical::PhysicalRef;
 use crate::element::{fault_error, full, one_point, ElementOut, Formulation, Nodal, StepInput};
-use crate::model::{ChunkOut, Group, Part, CHUNK};
+use crate::model::{ChunkOut, ElementTotals, Group, Part, CHUNK};
 use material::real::{F64x8, Mask, Real, LANES};
 use material::{with_law, Law};
 use rayon::prelude::*;
 use std::sync::OnceLock;
-/// Sum of the element loop's scalar outputs.
-#[derive(Clone, Copy, Debug, Default)]
-pub struct ElementTotals {
-    /// Smallest critical step (s).
-    pub dt_min: f64,
-    /// Element with the smallest step.
-    pub dt_elem: u32,
-    /// Stored hourglass energy (J).
-    pub hg_stored: f64,
-    /// Hourglass dissipation power (W).
-    pub hg_power: f64,
-    /// Largest hourglass energy of one element this step (J): stored energy plus power x dt.
-    pub hg_peak: f64,
-    /// The element (global id) with that largest hourglass energy.
-    pub hg_peak_elem: u32,
-    /// Bulk-viscous power (W).
-    pub bulk_power: f64,
-    /// Law dissipation this step (J).
-    pub law_dissipation: f64,
-    /// Elements that reached their failure criterion this step and are eroded from the next.
-    pub newly_eroded: u32,
-    /// The first of them (global id).
-    pub first_eroded: Option<u32>,
-}
-
 /// A raw pointer shared by the element loop to write disjoint ranges: history and stress per
 /// element, chunk results per chunk, nodal forces per node of a colour's chunks.
 #[derive(Clone, Copy)]
@@ -145,10 +120,7 @@ pub fn element_loop(
     let stress_ptr = stress.map(|s| Shared(s.as_mut_ptr()));
     force.par_chunks_mut(4096).for_each(|c| c.fill([0.0; 3]));
     let force_ptr = Shared(force.as_mut_ptr());
-    let mut tot = ElementTotals {
-        dt_min: f64::INFINITY,
-        ..Default::default()
-    };
+    let mut tot = ElementTotals::EMPTY;
     for g in groups.iter_mut() {
         let part = &parts[g.part];
         let n = g.elements.len();
@@ -176,42 +148,32 @@ pub fn element_loop(
             }
         });
         g.chunks = chunks;
-        let (mut hg_stored, mut hg_power) = (0.0, 0.0);
+        // the run's totals chunk by chunk in chunk order (bitwise), the group's beside
+        let mut group = ElementTotals::EMPTY;
         for ch in &g.chunks {
             if let Some(e) = &ch.error {
                 return Err(e.clone());
             }
             // Erosion (LS-DYNA element deletion): a failed element keeps its nodal mass and
             // carries no force from the next step on. The eroded array exists only once an
-            // element of the group has failed.
+            // element of the group has failed. A chunk skips eroded elements, so the elements
+            // it reports failed (and counts in its totals) are newly failed.
             for &le in &ch.failed {
                 if g.eroded.is_empty() {
                     g.eroded = vec![false; n];
                 }
-                if !g.eroded[le as usize] {
-                    g.eroded[le as usize] = true;
-                    tot.newly_eroded += 1;
-                    tot.first_eroded.get_or_insert(g.elements[le as usize]);
-                }
+                debug_assert!(!g.eroded[le as usize]);
+                g.eroded[le as usize] = true;
             }
-            if ch.dt_min * g.dt_kappa < tot.dt_min {
-                tot.dt_min = ch.dt_min * g.dt_kappa;
-                tot.dt_elem = ch.dt_elem;
-            }
-            // the run's totals in the order they always had (bitwise), the group's beside
-            tot.hg_stored += ch.hg_stored;
-            tot.hg_power += ch.hg_power;
-            hg_stored += ch.hg_stored;
-            hg_power += ch.hg_power;
-            if ch.hg_peak > tot.hg_peak {
-                tot.hg_peak = ch.hg_peak;
-                tot.hg_peak_elem = ch.hg_peak_elem;
-            }
-            tot.bulk_power += ch.bulk_power;
-            tot.law_dissipation += ch.law_dissipation;
+            let c = ElementTotals {
+                dt_min: ch.totals.dt_min * g.dt_kappa,
+                ..ch.totals
+            };
+            tot.combine(&c);
+            group.combine(&c);
         }
-        g.hourglass.stored = hg_stored;
-        g.hourglass.power = hg_power;
+        g.hourglass.stored = group.hg_stored;
+        g.hourglass.power = group.hg_power;
     }
     Ok(tot)
 }
@@ -246,7 +208,7 @@ fn run_chunk_body<L: Law, G: GatherLanes>(l: &L, b: &Batch, ci: usize) -> ChunkO
     let n = g.elements.len();
     let stride = g.history_stride;
     let mut acc = ChunkOut {
-        dt_min: f64::INFINITY,
+        totals: ElementTotals::EMPTY,
         ..Default::default()
     };
     let first = ci * (CHUNK / LANES);
@@ -325,23 +287,23 @@ fn run_chunk_body<L: Law, G: GatherLanes>(l: &L, b: &Batch, ci: usize) -> ChunkO
                 acc.rescale.push((le as u32, s_l[q] * r * r));
                 dt = g.dt_floor;
             }
-            if dt < acc.dt_min {
-                acc.dt_min = dt;
-                acc.dt_elem = g.elements[le];
-            }
             let (hs, hp) = (hs_l[q], hp_l[q]);
-            acc.hg_stored += hs;
-            acc.hg_power += hp;
-            let hg = hs + hp * b.input.dt;
-            if hg > acc.hg_peak {
-                acc.hg_peak = hg;
-                acc.hg_peak_elem = g.elements[le];
-            }
-            acc.bulk_power += bulk_l[q];
-            acc.law_dissipation += diss_l[q];
-            if o.failed.lane(q) {
+            let failed = o.failed.lane(q);
+            if failed {
                 acc.failed.push(le as u32);
             }
+            acc.totals.combine(&ElementTotals {
+                dt_min: dt,
+                dt_elem: g.elements[le],
+                hg_stored: hs,
+                hg_power: hp,
+                hg_peak: hs + hp * b.input.dt,
+                hg_peak_elem: g.elements[le],
+                bulk_power: bulk_l[q],
+                law_dissipation: diss_l[q],
+                newly_eroded: failed as u32,
+                first_eroded: failed.then_some(g.elements[le]),
+            });
             if let Some(sp) = b.stress {
                 // SAFETY: one element writes one entry.
                 unsafe {

@@ -5,7 +5,6 @@
 pub mod bc;
 pub mod campaign;
 pub mod contact_stage;
-pub mod curve;
 pub mod element;
 pub mod forces;
 pub mod generate;

@@ -68,6 +68,10 @@ pub enum SolverError {
         /// Worst part.
         part: String,
     },
+    /// The run went unstable: non-finite energies, or a negative internal energy (the
+    /// stability guard of [`crate::simulation::Simulation::step`]). The message says when and
+    /// why.
+    Unstable(String),
     /// Any other invalid input.
     Invalid(String),
 }
@@ -92,32 +96,91 @@ impl fmt::Display for SolverError {
                 added_fraction * 100.0,
                 limit * 100.0
             ),
-            SolverError::Invalid(s) => f.write_str(s),
+            SolverError::Unstable(s) | SolverError::Invalid(s) => f.write_str(s),
         }
     }
 }
 
 impl std::error::Error for SolverError {}
 
-/// Partial results of one chunk of the element loop.
-#[derive(Clone, Debug, Default)]
-pub struct ChunkOut {
-    /// Smallest element step.
+/// The element loop's scalar results, and their one reduction: an element's results, a
+/// chunk's and the whole loop's are all an `ElementTotals`, and [`ElementTotals::combine`] folds
+/// them, element by element inside a chunk and chunk by chunk (in chunk order) across the
+/// groups, so that the sums are formed in the same order on any thread count.
+#[derive(Clone, Copy, Debug)]
+pub struct ElementTotals {
+    /// Smallest critical step (s).
     pub dt_min: f64,
     /// Element with the smallest step (global id).
     pub dt_elem: u32,
-    /// Stored hourglass energy.
+    /// Stored hourglass energy (J).
     pub hg_stored: f64,
-    /// Hourglass power.
+    /// Hourglass dissipation power (W).
     pub hg_power: f64,
-    /// Largest hourglass energy of one element (stored + power x dt).
+    /// Largest hourglass energy of one element this step (J): stored energy plus power x dt.
     pub hg_peak: f64,
-    /// The element (global id) with it.
+    /// The element (global id) with that largest hourglass energy.
     pub hg_peak_elem: u32,
-    /// Bulk-viscous power.
+    /// Bulk-viscous power (W).
     pub bulk_power: f64,
-    /// Law dissipation.
+    /// Law dissipation this step (J).
     pub law_dissipation: f64,
+    /// Elements that reached their failure criterion this step and are eroded from the next.
+    pub newly_eroded: u32,
+    /// The first of them (global id).
+    pub first_eroded: Option<u32>,
+}
+
+impl ElementTotals {
+    /// Nothing yet: the identity of [`ElementTotals::combine`] (an infinite step, zero sums).
+    pub const EMPTY: ElementTotals = ElementTotals {
+        dt_min: f64::INFINITY,
+        dt_elem: 0,
+        hg_stored: 0.0,
+        hg_power: 0.0,
+        hg_peak: 0.0,
+        hg_peak_elem: 0,
+        bulk_power: 0.0,
+        law_dissipation: 0.0,
+        newly_eroded: 0,
+        first_eroded: None,
+    };
+
+    /// Fold `o`, which comes after `self`, into `self`: the smaller step and the larger
+    /// hourglass peak win (the earlier one on a tie), sums and counts add, the first eroded
+    /// element stays the first.
+    #[inline(always)]
+    pub fn combine(&mut self, o: &ElementTotals) {
+        if o.dt_min < self.dt_min {
+            self.dt_min = o.dt_min;
+            self.dt_elem = o.dt_elem;
+        }
+        self.hg_stored += o.hg_stored;
+        self.hg_power += o.hg_power;
+        if o.hg_peak > self.hg_peak {
+            self.hg_peak = o.hg_peak;
+            self.hg_peak_elem = o.hg_peak_elem;
+        }
+        self.bulk_power += o.bulk_power;
+        self.law_dissipation += o.law_dissipation;
+        self.newly_eroded += o.newly_eroded;
+        if self.first_eroded.is_none() {
+            self.first_eroded = o.first_eroded;
+        }
+    }
+}
+
+impl Default for ElementTotals {
+    fn default() -> Self {
+        ElementTotals::EMPTY
+    }
+}
+
+/// One chunk of the element loop: its [`ElementTotals`] and what the loop applies after it.
+#[derive(Clone, Debug, Default)]
+pub struct ChunkOut {
+    /// The chunk's totals (its smallest step not yet multiplied by the group's `dt_kappa`).
+    pub totals: ElementTotals,
     /// First error: (global element, message).
     pub error: Option<(u32, String)>,
     /// Elements (group-local index) that reached their law's failure criterion this step.

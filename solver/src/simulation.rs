@@ -23,8 +23,8 @@
 
 use crate::bc::{Constraint, Kinematic, NodalLoad};
 use crate::element::{BulkViscosity, StepInput};
-use crate::forces::{element_loop, ElementTotals};
-use crate::model::{Model, SolverError};
+use crate::forces::element_loop;
+use crate::model::{ElementTotals, Model, SolverError};
 use rayon::prelude::*;
 use std::time::{Duration, Instant};
 
@@ -700,6 +700,10 @@ impl Simulation {
 
     /// Take one step from t^n to t^(n+1). If the new time reaches `stress_at` (s), the Cauchy
     /// stress of the new state is stored in `self.stress` (when stress output was requested).
+    /// Every step runs the run's guards, whoever calls it: the step-size floor
+    /// (`settings.dt_min`), the hourglass guard ([`HourglassLimit`], when set) and the
+    /// stability guard (non-finite energies or a negative internal energy,
+    /// [`SolverError::Unstable`]).
     pub fn step(&mut self, stress_at: f64) -> Result<(), SolverError> {
         self.initialise()?;
         // The step is chosen first, with every clamp (dt_max, relaxation, a stage's own limit),
@@ -740,7 +744,8 @@ impl Simulation {
         self.check_hourglass()?;
         // Forces at the new state, for the next step (and its stable dt).
         let want = self.stress.is_some() && self.time >= stress_at;
-        self.internal_forces(want)
+        self.internal_forces(want)?;
+        self.check_stability()
     }
 
     /// The hourglass guard ([`HourglassLimit`]), on the energies just formed at t^n.
@@ -767,6 +772,54 @@ impl Simulation {
                 self.totals.hg_peak
             ),
         })
+    }
+
+    /// The stability guard, on the energies formed in this step (at t^n): every law here is
+    /// passive, so the internal energy (stored plus dissipated by the laws) cannot fall below
+    /// zero; when the central-difference scheme goes unstable, the spurious high-frequency
+    /// energy shows up as a large negative internal energy balanced by hourglass and
+    /// bulk-viscous dissipation. Also stops on non-finite energies. The message names the time
+    /// after the step and the element that sets the next step.
+    fn check_stability(&self) -> Result<(), SolverError> {
+        let e = &self.energy;
+        let all = [
+            e.kinetic,
+            e.internal,
+            e.hourglass,
+            e.bulk_viscous,
+            e.damping,
+            e.contact,
+            e.external,
+        ];
+        if all.iter().any(|x| !x.is_finite()) {
+            return Err(SolverError::Unstable(format!(
+                "the energies became non-finite at t = {:.6} ms",
+                self.time * 1e3
+            )));
+        }
+        let scale = all.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+        if e.internal < -0.05 * scale && scale > 0.0 {
+            let el = self.dt_element;
+            // The advice follows the dissipation that outran the work: bulk viscosity booked from
+            // each element's rate at the start of the step overshoots when a prescribed motion
+            // starts abruptly on nearly incompressible material.
+            let advice = if e.bulk_viscous >= e.hourglass {
+                "the bulk-viscous dissipation outran the work it absorbs, as when a prescribed motion starts abruptly: ramp the motion (kind = \"smooth_step\"), lower `run.dt_factor`, or lower the bulk viscosity"
+            } else {
+                "the hourglass dissipation outran the work it absorbs: lower `run.dt_factor`, or use stiffness or physical hourglass control"
+            };
+            return Err(SolverError::Unstable(format!(
+                "numerical instability at t = {:.6} ms: the internal energy became negative ({:.4e} J; hourglass {:.4e} J, bulk viscosity {:.4e} J, external work {:.4e} J). The step was set by element {el} (part {}), `run.dt_factor` {}; {advice}",
+                self.time * 1e3,
+                e.internal,
+                e.hourglass,
+                e.bulk_viscous,
+                e.external,
+                self.part_of(el),
+                self.settings.dt_factor
+            )));
+        }
+        Ok(())
     }
 
     /// The nodal update with kinematic conditions and the energy sums.

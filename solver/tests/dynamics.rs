@@ -11,10 +11,10 @@
 //! T = 2 pi / ((bL)^2 sqrt(E I / (rho A L^4))) must be matched within 3 %.
 
 mod common;
+use contact::Curve;
 use material::linear_elastic::{Kinematics, LinearElastic};
 use material::Material;
 use solver::bc::{Constraint, Kinematic};
-use solver::curve::Curve;
 use solver::element::{Formulation, Hourglass};
 use solver::generate::{box_mesh, BoxSpec};
 use solver::model::{Model, Part};
@@ -60,7 +60,7 @@ fn bar_wave_front_arrives_at_l_over_c() {
         Constraint {
             nodes: ns["zmin"].clone(),
             dof: 2,
-            kind: Kinematic::Velocity(Curve::Constant(v0)),
+            kind: Kinematic::Velocity(Curve::Constant { value: v0 }),
         },
         Constraint {
             nodes: ns["zmax"].clone(),

@@ -4,10 +4,10 @@
 //! A homogeneous deformation satisfies equilibrium for any homogeneous material, so the
 //! exact answer is u = A X + b at every node, whatever the law.
 
+use contact::Curve;
 use material::neo_hookean::NeoHookean;
 use material::Material;
 use solver::bc::{Constraint, Kinematic};
-use solver::curve::Curve;
 use solver::element::{Formulation, Hourglass, HourglassForm};
 use solver::generate::{box_mesh, BoxSpec};
 use solver::model::{Model, Part};
@@ -46,7 +46,7 @@ fn patch(form: Formulation) -> f64 {
             constraints.push(Constraint {
                 nodes: vec![n],
                 dof: d,
-                kind: Kinematic::Displacement(Curve::Constant(u[d])),
+                kind: Kinematic::Displacement(Curve::Constant { value: u[d] }),
             });
         }
     }

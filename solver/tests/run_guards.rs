@@ -108,10 +108,10 @@ fn hourglass_guard_refuses_a_non_positive_ratio() {
 
 #[test]
 fn excessive_distortion_stops_before_inversion() {
+    use contact::Curve;
     use material::neo_hookean::NeoHookean;
     use material::Material;
     use solver::bc::{Constraint, Kinematic};
-    use solver::curve::Curve;
     use solver::element::Formulation;
     use solver::generate::{box_mesh, BoxSpec};
     use solver::model::{Model, Part, SolverError};
@@ -139,7 +139,7 @@ fn excessive_distortion_stops_before_inversion() {
         c.push(Constraint {
             nodes: vec![7],
             dof: d,
-            kind: Kinematic::Displacement(Curve::SmoothStep {
+            kind: Kinematic::Displacement(Curve::SmoothStepBetween {
                 t0: 0.0,
                 t1: 0.01,
                 from: 0.0,

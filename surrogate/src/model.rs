@@ -27,6 +27,7 @@ use crate::domain::TrainingDomain;
 use crate::error::{Error, Result};
 use crate::gp::{GpModel, GpPredictor, SeArd};
 use crate::mlp::{DenseLayer, MlpModel, MlpPredictor};
+use crate::model_kind::ModelKind;
 use crate::normalise::Scaling;
 use crate::report::TrainReport;
 use crate::target::TargetMap;
@@ -42,39 +43,6 @@ use std::path::{Path, PathBuf};
 pub const MODEL_FORMAT: &str = "palpa-surrogate";
 /// Current value of [`ModelMeta::version`].
 pub const MODEL_VERSION: u32 = 2;
-
-/// The surrogate families.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize, Deserialize)]
-#[serde(rename_all = "snake_case")]
-pub enum ModelKind {
-    /// Multilayer perceptron.
-    Mlp,
-    /// Gaussian process.
-    Gp,
-}
-
-impl std::fmt::Display for ModelKind {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.write_str(match self {
-            ModelKind::Mlp => "mlp",
-            ModelKind::Gp => "gp",
-        })
-    }
-}
-
-impl std::str::FromStr for ModelKind {
-    type Err = Error;
-    fn from_str(s: &str) -> Result<Self> {
-        match s.to_ascii_lowercase().as_str() {
-            "mlp" => Ok(ModelKind::Mlp),
-            "gp" => Ok(ModelKind::Gp),
-            other => Err(Error::invalid(
-                "model kind",
-                format!("{other:?}, expected mlp or gp"),
-            )),
-        }
-    }
-}
 
 /// Metadata sidecar of a saved model.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]

@@ -1,7 +1,7 @@
 //! What training and evaluation report: Fit per location and overall, training time, latency,
 //! and the accuracy-versus-cost table.
 
-use crate::model::ModelKind;
+use crate::model_kind::ModelKind;
 use crate::target::Target;
 use serde::{Deserialize, Serialize};
 use std::fmt;

@@ -143,7 +143,7 @@ impl ServedModel {
 mod tests {
     use super::*;
     use crate::api::{train, TrainOptions};
-    use crate::model::ModelKind;
+    use crate::model_kind::ModelKind;
     use crate::synthetic::make_synthetic_dataset;
     use crate::view::{Fingers, VIEW_FORMAT, VIEW_VERSION};
 

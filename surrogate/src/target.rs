@@ -19,7 +19,7 @@
 
 use crate::dataset::Dataset;
 use crate::error::{Error, Result};
-use crate::model::ModelKind;
+use crate::model_kind::ModelKind;
 use crate::principal::max_principal_rows;
 use ndarray::Array2;
 use serde::{Deserialize, Serialize};

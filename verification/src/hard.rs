@@ -30,10 +30,10 @@
 
 use crate::cases::{short, FULL_FBAR, ONE_POINT_VISCOUS_SHEAR};
 use crate::{CaseOutput, Row, Status};
+use contact::Curve;
 use material::neo_hookean::NeoHookean;
 use material::Material;
 use solver::bc::{Constraint, Kinematic};
-use solver::curve::Curve;
 use solver::element::Formulation;
 use solver::generate::{box_mesh, BoxSpec};
 use solver::mesh::Mesh;
@@ -237,7 +237,7 @@ pub fn flesh_compression(form: Formulation) -> Result<HardRun, String> {
     c.push(disp(
         &ns["zmax"],
         2,
-        Curve::SmoothStep {
+        Curve::SmoothStepBetween {
             t0: 0.0,
             t1: 0.02,
             from: 0.0,
@@ -260,7 +260,7 @@ pub fn liver_stretches() -> Result<HardRun, String> {
         disp(
             &ns["zmax"],
             2,
-            Curve::Table(vec![(0.0, 0.0), (0.1, -0.5 * h), (0.2, 0.6 * h)]),
+            Curve::Polyline(vec![(0.0, 0.0), (0.1, -0.5 * h), (0.2, 0.6 * h)]),
         ),
     ];
     let mut s = sim(m, library("paper:liver"), ONE_POINT_VISCOUS_SHEAR, c)?;
@@ -284,7 +284,7 @@ pub fn ribs_bending() -> Result<(HardRun, f64), String> {
     c.push(disp(
         &mid,
         2,
-        Curve::SmoothStep {
+        Curve::SmoothStepBetween {
             t0: 0.0,
             t1: 0.02,
             from: 0.0,
@@ -320,7 +320,7 @@ pub fn inversion() -> Result<HardRun, String> {
         c.push(disp(
             &[corner],
             d,
-            Curve::SmoothStep {
+            Curve::SmoothStepBetween {
                 t0: 0.0,
                 t1: 0.01,
                 from: 0.0,
@@ -337,17 +337,29 @@ pub fn inversion() -> Result<HardRun, String> {
     Ok(run_explicit(&mut s, 0.01, |_| {}))
 }
 
+/// The library's liver card with its Prony series on `prony_on`, changed on the parsed card
+/// (an edit of the card's text that stopped matching would silently keep the library's
+/// setting).
+fn liver_with_prony_on(prony_on: &str) -> Result<material::MaterialSpec, String> {
+    let mut card = material::named("paper:liver")?;
+    match &mut card {
+        material::MaterialSpec::Ogden(o) => {
+            o.prony_on = Some(prony_on.to_string());
+            Ok(card)
+        }
+        _ => Err("paper:liver is not an Ogden card".into()),
+    }
+}
+
 /// Instantaneous Poisson ratio of the liver law (material driver, jump to stretch 0.99):
 /// (observed, closed form) for `prony_on`.
 pub fn liver_poisson(prony_on: &str) -> Result<(f64, f64), String> {
-    let card = material::library::LIVER.replace(
-        "prony_on = \"green_lagrange\"",
-        &format!("prony_on = \"{prony_on}\""),
-    );
-    let text = format!(
-        "mode = \"uniaxial_stress\"\n[[segment]]\nramp_to = 0.999\nduration = 0\nsteps = 1\n[material]\n{card}"
-    );
-    let o = material::driver::run_driver_str(&text, None)?;
+    let mut spec: material::driver::DriverSpec = toml::from_str(
+        "material = \"paper:liver\"\nmode = \"uniaxial_stress\"\n[[segment]]\nramp_to = 0.999\nduration = 0\nsteps = 1\n",
+    )
+    .map_err(|e| e.to_string())?;
+    spec.material = liver_with_prony_on(prony_on)?;
+    let o = material::driver::run_driver(&spec, None)?;
     let ly = o.column("stretch_y").ok_or("no stretch_y")?;
     let l = o.column("stretch").ok_or("no stretch")?;
     let n = l.len() - 1;
@@ -382,7 +394,7 @@ pub fn liver_negative_poisson_block() -> Result<(HardRun, f64), String> {
         disp(
             &ns["zmax"],
             2,
-            Curve::SmoothStep {
+            Curve::SmoothStepBetween {
                 t0: 0.0,
                 t1: 0.002,
                 from: 0.0,
@@ -390,11 +402,7 @@ pub fn liver_negative_poisson_block() -> Result<(HardRun, f64), String> {
             },
         ),
     ];
-    let card = material::library::LIVER
-        .replace("prony_on = \"green_lagrange\"", "prony_on = \"deviatoric\"");
-    let mat = toml::from_str::<material::MaterialSpec>(&card)
-        .map_err(|e| e.to_string())?
-        .build("liver")?;
+    let mat = liver_with_prony_on("deviatoric")?.build("liver")?;
     let xmax = ns["xmax"].clone();
     let mut s = sim(m, mat, ONE_POINT_VISCOUS_SHEAR, c)?;
     let r = run_explicit(&mut s, 0.003, |_| {});

@@ -12,7 +12,8 @@
 //! - [`cases::cantilever`]: tip deflection vs scikit-fem Q1 and Timoshenko beam theory.
 //! - [`cases::closed`]: Ogden, Prony, plasticity, wave speed, free vibration, Hertz.
 //! - [`hard`]: the hard-case suite (`palpa verify --hard`).
-//! - [`study`]: accuracy against cost (`palpa study`).
+//! - [`study`]: accuracy against cost (`palpa study`), with its Hertz block ([`study_hertz`])
+//!   and its rows ([`study_row`]).
 //!
 //! [`run_suite`] runs the default suite; [`report`] prints the table and writes the Markdown
 //! report and the convergence plots.
@@ -26,6 +27,7 @@ pub mod quasi;
 pub mod report;
 pub mod study;
 pub mod study_hertz;
+pub mod study_row;
 
 pub use report::{Row, Status};
 

@@ -3,9 +3,9 @@
 //! falls below a tolerance times the internal force norm. Prescribed displacements given as
 //! constant curves are applied in the first step.
 
+use contact::Curve;
 use material::Material;
 use solver::bc::{Constraint, Kinematic, NodalLoad};
-use solver::curve::Curve;
 use solver::element::Formulation;
 use solver::mesh::Mesh;
 use solver::model::{Model, Part};
@@ -49,7 +49,7 @@ pub fn prescribe_node(out: &mut Vec<Constraint>, node: u32, u: [f64; 3]) {
             kind: if x == 0.0 {
                 Kinematic::Fixed
             } else {
-                Kinematic::Displacement(Curve::Constant(x))
+                Kinematic::Displacement(Curve::Constant { value: x })
             },
         });
     }
@@ -62,7 +62,7 @@ pub fn on(nodes: &[u32], dof: usize, value: Option<f64>) -> Constraint {
         dof,
         kind: match value {
             None => Kinematic::Fixed,
-            Some(x) => Kinematic::Displacement(Curve::Constant(x)),
+            Some(x) => Kinematic::Displacement(Curve::Constant { value: x }),
         },
     }
 }

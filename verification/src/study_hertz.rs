@@ -12,7 +12,7 @@
 
 use crate::cases::closed::{hertz_force, hertz_scene};
 use crate::hard::run_contact_scene;
-use crate::study::StudyRow;
+use crate::study_row::StudyRow;
 
 /// One Hertz setting.
 #[derive(Clone, Debug)]

@@ -15,7 +15,7 @@
 //! dataset uses it for the force input of the surrogate, sampled at the sample times from the
 //! run's full `history.csv`.
 
-use crate::curve::Curve;
+use contact::Curve;
 
 /// Width of the centred moving average applied to hand-force histories (s).
 pub const FORCE_FILTER: f64 = 1e-3;
@@ -40,7 +40,7 @@ pub fn moving_average(t: &[f64], f: &[f64], width: f64) -> Vec<f64> {
 
 /// The centred moving average of (t, f) over `width`, linearly interpolated at `at`.
 pub fn moving_average_at(t: &[f64], f: &[f64], width: f64, at: &[f64]) -> Vec<f64> {
-    let smooth = Curve::Table(t.iter().copied().zip(moving_average(t, f, width)).collect());
+    let smooth = Curve::Polyline(t.iter().copied().zip(moving_average(t, f, width)).collect());
     at.iter().map(|&x| smooth.value(x)).collect()
 }
 

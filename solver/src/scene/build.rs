@@ -2,71 +2,18 @@
 
 use super::bulk::bulk_knob;
 use super::contact_spec::HandScene;
-use super::def::{DtMin, HourglassGuard, PartDef, SceneDef, Setup};
+use super::def::{DtMin, HourglassGuard, OutputPlan, PartDef, Scene, SceneDef, Setup};
 use super::spec::*;
 use crate::bc::{Constraint, Kinematic, NodalLoad};
-use crate::curve::Curve;
 use crate::element::{BulkViscosity, Formulation, Hourglass, HourglassForm, HourglassModulus};
 use crate::generate::{box_mesh, BoxSpec};
 use crate::mesh::Mesh;
 use crate::model::MassScaling;
 use crate::phantom::Phantom;
-use crate::simulation::{DynamicRelaxation, Simulation};
+use crate::simulation::DynamicRelaxation;
 use material::quantity::Length;
 use material::Material;
-use std::path::{Path, PathBuf};
-
-/// What the output writer is asked for.
-#[derive(Clone, Debug)]
-pub struct OutputPlan {
-    /// Interval between VTK frames (s); None disables VTK output (frames may still be taken
-    /// for the probe, see `frame_interval`).
-    pub vtk_interval: Option<f64>,
-    /// Interval between history rows (s).
-    pub history_interval: f64,
-    /// Requested point and cell fields.
-    pub fields: Vec<String>,
-    /// Node sets whose reactions are written: (name, nodes).
-    pub reactions: Vec<(String, Vec<u32>)>,
-    /// Interval between frames (s): stress snapshots written to VTK and/or the probe files;
-    /// None when neither is written.
-    pub frame_interval: Option<f64>,
-    /// Element set sampled into `probe.csv` at every frame: (name, element ids).
-    pub probe: Option<(String, Vec<u32>)>,
-}
-
-impl OutputPlan {
-    /// Whether a field was requested.
-    pub fn has(&self, f: &str) -> bool {
-        self.fields.iter().any(|x| x == f)
-    }
-    /// Whether any stress-derived field was requested.
-    pub fn needs_stress(&self) -> bool {
-        self.has("stress") || self.has("von_mises") || self.has("max_principal")
-    }
-}
-
-/// A scene ready to run.
-pub struct Scene {
-    /// The simulation.
-    pub sim: Simulation,
-    /// End time (s).
-    pub end_time: f64,
-    /// Output plan.
-    pub output: OutputPlan,
-    /// Title.
-    pub title: String,
-    /// Source file.
-    pub path: PathBuf,
-    /// The phantom the mesh came from (its ROI, locations and skin faces; its `mesh` field is
-    /// emptied, the simulation owns the mesh), for `generator = "phantom"`.
-    pub phantom: Option<Phantom>,
-    /// Things the builder adjusted that the user should know (printed before the run).
-    pub notes: Vec<String>,
-    /// What runs on the mesh, as resolved (indenters as they run: hands turned into their
-    /// capsules and placed), for `palpa export`.
-    pub setup: super::def::Setup,
-}
+use std::path::Path;
 
 /// A scene error with its location.
 fn err(
@@ -104,45 +51,6 @@ fn axis(s: &str) -> Option<usize> {
         "z" => Some(2),
         _ => None,
     }
-}
-
-/// Convert a curve spec, with values already in SI through their typed unit.
-pub fn curve<Q: Copy + Into<f64>>(c: &CurveSpec<Q>) -> Result<Curve, String> {
-    let cv = match c {
-        CurveSpec::Constant { value } => Curve::Constant((*value).into()),
-        CurveSpec::SmoothStep {
-            value,
-            from,
-            start,
-            end,
-        } => Curve::SmoothStep {
-            t0: start.map(|t| t.0).unwrap_or(0.0),
-            t1: end.0,
-            from: from.map(|f| f.into()).unwrap_or(0.0),
-            to: (*value).into(),
-        },
-        CurveSpec::Ramp { value, start, end } => {
-            let t0 = start.map(|t| t.0).unwrap_or(0.0);
-            Curve::Table(vec![(t0, 0.0), (end.0, (*value).into())])
-        }
-        CurveSpec::Table { time, value } => {
-            if time.len() != value.len() {
-                return Err(format!(
-                    "table has {} times but {} values",
-                    time.len(),
-                    value.len()
-                ));
-            }
-            Curve::Table(
-                time.iter()
-                    .zip(value)
-                    .map(|(t, v)| (t.0, (*v).into()))
-                    .collect(),
-            )
-        }
-    };
-    cv.validate()?;
-    Ok(cv)
 }
 
 fn read_mesh(
@@ -495,7 +403,7 @@ pub fn resolve_scene(
                 )
             })?,
             None if material::library::is_library_name(&ps.material) => {
-                material::library::named(&ps.material)
+                material::named(&ps.material)
                     .and_then(|c| c.build_in(&ps.material, base))
                     .map_err(|m| e(&format!("{key}.material"), Some(&ps.material), &m))?
             }
@@ -515,7 +423,7 @@ pub fn resolve_scene(
             formulation(ps).map_err(|m| e(&key, Some(&format!("\"{pname}\"")), &m))?;
         let card = match spec.materials.get(&ps.material) {
             Some(card) => card.clone(),
-            None => material::library::named(&ps.material)
+            None => material::named(&ps.material)
                 .map_err(|m| e(&format!("{key}.material"), Some(&ps.material), &m))?,
         };
         let (material, card, bulk) = bulk_knob(ps, material, card)
@@ -587,7 +495,8 @@ pub fn resolve_scene(
         if let Some(d) = &b.displacement {
             for (a, c) in [&d.x, &d.y, &d.z].into_iter().enumerate() {
                 if let Some(c) = c {
-                    let cv = curve(c)
+                    let cv = c
+                        .boundary_curve()
                         .map_err(|m| e(&format!("{key}.displacement"), Some("displacement"), &m))?;
                     constraints.push(Constraint {
                         nodes: nodes.clone(),
@@ -600,7 +509,8 @@ pub fn resolve_scene(
         if let Some(d) = &b.velocity {
             for (a, c) in [&d.x, &d.y, &d.z].into_iter().enumerate() {
                 if let Some(c) = c {
-                    let cv = curve(c)
+                    let cv = c
+                        .boundary_curve()
                         .map_err(|m| e(&format!("{key}.velocity"), Some("velocity"), &m))?;
                     constraints.push(Constraint {
                         nodes: nodes.clone(),
@@ -622,8 +532,10 @@ pub fn resolve_scene(
         };
         for (a, c) in [&l.force.x, &l.force.y, &l.force.z].into_iter().enumerate() {
             if let Some(c) = c {
-                let mut cv = curve(c).map_err(|m| e(&format!("{key}.force"), Some("force"), &m))?;
-                scale_curve(&mut cv, share);
+                let cv = c
+                    .boundary_curve()
+                    .map_err(|m| e(&format!("{key}.force"), Some("force"), &m))?
+                    .scaled(share);
                 loads.push(NodalLoad {
                     nodes: nodes.clone(),
                     dof: a,
@@ -899,15 +811,4 @@ fn place_hand(h: &mut HandScene, phantom: Option<&Phantom>) -> Result<(), String
         h.direction = Some(loc.inward_normal);
     }
     Ok(())
-}
-
-fn scale_curve(c: &mut Curve, s: f64) {
-    match c {
-        Curve::Constant(v) => *v *= s,
-        Curve::Table(p) => p.iter_mut().for_each(|x| x.1 *= s),
-        Curve::SmoothStep { from, to, .. } => {
-            *from *= s;
-            *to *= s;
-        }
-    }
 }

@@ -68,7 +68,7 @@
 use material::quantity::{Force, Length, Number, Time, Velocity};
 use serde::Deserialize;
 
-use super::spec::CurveSpec;
+use super::curve_spec::CurveSpec;
 
 /// `[[indenter]]`: a rigid indenter, the union of its parts, moving along `direction`.
 #[derive(Debug, Deserialize)]

@@ -10,16 +10,14 @@
 //! into their two capsules and backed off the skin), so that a scene can be written out again
 //! (`palpa export --lsdyna`) from exactly what palpa runs.
 
-use super::build::{OutputPlan, Scene};
+use super::contact_def::ContactDef;
 use crate::bc::{Constraint, NodalLoad};
 use crate::element::{BulkViscosity, Formulation};
 use crate::mesh::Mesh;
 use crate::model::{MassScaling, Model, Part};
 use crate::phantom::Phantom;
 use crate::simulation::{DynamicRelaxation, HourglassLimit, LoopSettings, Simulation};
-use contact::{ContactParams, HandSpec, IndenterSpec};
 use material::{Material, MaterialSpec};
-use std::collections::HashSet;
 use std::path::PathBuf;
 
 /// One part: its law, the card it was built from, and its element formulation.
@@ -55,60 +53,6 @@ pub struct HourglassGuard {
     pub ratio: f64,
     /// From when it is checked (s).
     pub after: Option<f64>,
-}
-
-/// A rigid indenter with the place its definition came from (for messages).
-#[derive(Clone, Debug)]
-pub struct IndenterDef {
-    /// The indenter (SI).
-    pub spec: IndenterSpec,
-    /// `FILE:LINE` (or `FILE`) of its definition.
-    pub origin: String,
-}
-
-/// A two-finger hand before it is placed against the skin.
-#[derive(Clone, Debug)]
-pub struct HandDef {
-    /// The hand (SI); `gap` is the given one, or 0.
-    pub hand: HandSpec,
-    /// Whether the scene gave `gap` (else a hand that starts inside the skin is backed off).
-    pub gap_given: bool,
-    /// Whether it was placed on a phantom location (then its travel is extended by the
-    /// back-off, so that the indentation beyond first contact is the requested one).
-    pub placed: bool,
-    /// `FILE:LINE` (or `FILE`) of its definition.
-    pub origin: String,
-}
-
-/// Which boundary faces of the mesh take part in contact: every boundary face, restricted by
-/// each selection that is given.
-#[derive(Clone, Debug, Default)]
-pub struct SurfaceSel {
-    /// Only faces whose four nodes are all marked (a node set).
-    pub nodes: Option<Vec<bool>>,
-    /// Only faces of elements of the marked parts.
-    pub parts: Option<Vec<bool>>,
-    /// Only these faces (sorted node ids), e.g. an LS-DYNA segment set.
-    pub faces: Option<HashSet<[u32; 4]>>,
-}
-
-/// The contact of a scene: rigid indenters against the boundary of the mesh.
-#[derive(Clone, Debug)]
-pub struct ContactDef {
-    /// Indenters (before assembly: those given as such; after: every one, hands included, in
-    /// history-column order).
-    pub indenters: Vec<IndenterDef>,
-    /// Hands still to be placed (empty after assembly).
-    pub hands: Vec<HandDef>,
-    /// The contact surface.
-    pub surface: SurfaceSel,
-    /// Penalty, friction and search settings; `design_dt = None` takes the run's initial step.
-    pub params: ContactParams,
-    /// Where the contact was defined and what selects its surface, for the message when the
-    /// selection leaves no face (e.g. "scene.toml: `contact`").
-    pub origin: String,
-    /// The hint given when no face is left.
-    pub empty_hint: String,
 }
 
 /// Everything but the mesh: what runs on it.
@@ -165,6 +109,58 @@ pub struct SceneDef {
     pub setup: Setup,
     /// Things the reader adjusted that the user should know (printed before the run).
     pub notes: Vec<String>,
+}
+
+/// What the output writer is asked for.
+#[derive(Clone, Debug)]
+pub struct OutputPlan {
+    /// Interval between VTK frames (s); None disables VTK output (frames may still be taken
+    /// for the probe, see `frame_interval`).
+    pub vtk_interval: Option<f64>,
+    /// Interval between history rows (s).
+    pub history_interval: f64,
+    /// Requested point and cell fields.
+    pub fields: Vec<String>,
+    /// Node sets whose reactions are written: (name, nodes).
+    pub reactions: Vec<(String, Vec<u32>)>,
+    /// Interval between frames (s): stress snapshots written to VTK and/or the probe files;
+    /// None when neither is written.
+    pub frame_interval: Option<f64>,
+    /// Element set sampled into `probe.csv` at every frame: (name, element ids).
+    pub probe: Option<(String, Vec<u32>)>,
+}
+
+impl OutputPlan {
+    /// Whether a field was requested.
+    pub fn has(&self, f: &str) -> bool {
+        self.fields.iter().any(|x| x == f)
+    }
+    /// Whether any stress-derived field was requested.
+    pub fn needs_stress(&self) -> bool {
+        self.has("stress") || self.has("von_mises") || self.has("max_principal")
+    }
+}
+
+/// A scene ready to run.
+pub struct Scene {
+    /// The simulation.
+    pub sim: Simulation,
+    /// End time (s).
+    pub end_time: f64,
+    /// Output plan.
+    pub output: OutputPlan,
+    /// Title.
+    pub title: String,
+    /// Source file.
+    pub path: PathBuf,
+    /// The phantom the mesh came from (its ROI, locations and skin faces; its `mesh` field is
+    /// emptied, the simulation owns the mesh), for `generator = "phantom"`.
+    pub phantom: Option<Phantom>,
+    /// Things the builder adjusted that the user should know (printed before the run).
+    pub notes: Vec<String>,
+    /// What runs on the mesh, as resolved (indenters as they run: hands turned into their
+    /// capsules and placed), for `palpa export`.
+    pub setup: Setup,
 }
 
 /// The most time steps a scene may take by the estimate of [`estimated_steps`] unless

@@ -6,11 +6,14 @@
 
 pub mod build;
 pub mod bulk;
+pub mod contact_def;
 pub mod contact_spec;
+pub mod curve_spec;
 pub mod def;
 pub mod phantom_spec;
 pub mod pilot;
 pub mod spec;
 
-pub use build::{load_scene, Scene};
+pub use build::load_scene;
+pub use def::Scene;
 pub use spec::SceneSpec;

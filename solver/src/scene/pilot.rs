@@ -32,7 +32,8 @@
 //! mass scaling or dynamic relaxation keeps the starting estimate: mass scaling holds the step
 //! at its target, and relaxation steps in fictitious time.
 
-use super::build::{build_scene_with, Scene};
+use super::build::build_scene_with;
+use super::def::Scene;
 use super::spec::SceneSpec;
 use crate::model::isochoric_step_at;
 use material::quantity::Number;

@@ -7,6 +7,8 @@ use material::MaterialSpec;
 use serde::Deserialize;
 use std::collections::BTreeMap;
 
+use super::curve_spec::CurveSpec;
+
 /// The whole scene.
 #[derive(Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -152,44 +154,6 @@ pub struct NodeSetSpec {
     pub tolerance: Option<Length>,
     /// Explicit node ids.
     pub nodes: Option<Vec<u32>>,
-}
-
-/// A curve of a quantity Q over time.
-#[derive(Debug, Deserialize, Clone)]
-#[serde(deny_unknown_fields, tag = "kind", rename_all = "snake_case")]
-pub enum CurveSpec<Q> {
-    /// A constant.
-    Constant {
-        /// Value.
-        value: Q,
-    },
-    /// Quintic smooth step from 0 (or `from`) to `value` between `start` and `end`.
-    SmoothStep {
-        /// Final value.
-        value: Q,
-        /// Initial value (default 0).
-        from: Option<Q>,
-        /// Start time (default 0).
-        start: Option<Time>,
-        /// End time.
-        end: Time,
-    },
-    /// Linear ramp from 0 to `value` between `start` and `end`, then held.
-    Ramp {
-        /// Final value.
-        value: Q,
-        /// Start time (default 0).
-        start: Option<Time>,
-        /// End time.
-        end: Time,
-    },
-    /// Piecewise linear table.
-    Table {
-        /// Times.
-        time: Vec<Time>,
-        /// Values.
-        value: Vec<Q>,
-    },
 }
 
 /// Curves per direction.

@@ -29,10 +29,10 @@ use super::{short, FULL, FULL_FBAR, ONE_POINT_PHYSICAL, ONE_POINT_STIFFNESS};
 use crate::data::{self, at, f, mesh, s, vec3, vec_u32};
 use crate::quasi::{model, on, relax};
 use crate::{CaseOutput, Row, Series};
+use contact::Curve;
 use material::linear_elastic::{Kinematics, LinearElastic};
 use material::Material;
 use solver::bc::NodalLoad;
-use solver::curve::Curve;
 use solver::element::Formulation;
 
 /// Tolerance of palpa's plain fully integrated element against scikit-fem Q1 (relative).
@@ -85,7 +85,7 @@ pub fn generated_tip(
         .map(|(&n, &fz)| NodalLoad {
             nodes: vec![n],
             dof: 2,
-            curve: Curve::Constant(fz),
+            curve: Curve::Constant { value: fz },
         })
         .collect();
     let c = (0..3).map(|d| on(&clamp, d, None)).collect();
@@ -139,7 +139,7 @@ pub fn tip_deflection(
                 loads.push(NodalLoad {
                     nodes: vec![n],
                     dof: d,
-                    curve: Curve::Constant(v[d]),
+                    curve: Curve::Constant { value: v[d] },
                 });
             }
         }

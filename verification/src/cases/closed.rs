@@ -35,11 +35,11 @@
 
 use super::{short, FULL, FULL_FBAR, ONE_POINT_STIFFNESS, ONE_POINT_VISCOUS};
 use crate::{CaseOutput, Row, Series};
+use contact::Curve;
 use material::driver::{run_driver_str, DriverOutput};
 use material::linear_elastic::{Kinematics, LinearElastic};
 use material::Material;
 use solver::bc::{Constraint, Kinematic};
-use solver::curve::Curve;
 use solver::element::Formulation;
 use solver::generate::{box_mesh, BoxSpec};
 use solver::model::{Model, Part};
@@ -259,7 +259,7 @@ pub fn wave_arrival() -> Result<(f64, f64), String> {
         Constraint {
             nodes: ns["zmin"].clone(),
             dof: 2,
-            kind: Kinematic::Velocity(Curve::Constant(v0)),
+            kind: Kinematic::Velocity(Curve::Constant { value: v0 }),
         },
         Constraint {
             nodes: ns["zmax"].clone(),
