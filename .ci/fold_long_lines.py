@@ -7,8 +7,9 @@ import sys
 LIMIT = 600
 KEEP = 250
 
-for line in sys.stdin:
-    body = line.rstrip("\n")
+for raw in sys.stdin.buffer:
+    # a stray invalid byte must not end the CI log in a traceback
+    body = raw.decode("utf-8", errors="replace").rstrip("\n")
     if len(body) > LIMIT:
         body = f"{body[:KEEP]} [... {len(body) - 2 * KEEP} characters folded ...] {body[-KEEP:]}"
     sys.stdout.write(body + "\n")
