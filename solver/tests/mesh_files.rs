@@ -639,3 +639,57 @@ fn gmsh_node_tags_past_2_64_or_given_twice_are_errors() {
         .expect("an error");
     assert!(e.contains("node block 1 gives a node tag twice"), "{e}");
 }
+
+/// Found while fuzzing abaqus (by reading the reader; afl did not reach it in 5 minutes): a
+/// `generate` line over the whole i64 range overflowed `last - first` (a panic in debug
+/// builds; in release the wrapped count passed the 1e8 limit and the range was listed id by
+/// id, a hang; 40 ranges of 1e8 ids were 4e9), and a set that lists itself doubled at each
+/// `*Nset` (60 lines of 15 bytes, 2^60 ids). Ranges are now kept as ranges and sets hold each
+/// label once.
+#[test]
+fn abaqus_huge_generate_range_or_self_doubling_set_is_an_error_or_cheap_not_a_hang() {
+    let hex = "*Node\n1, 0, 0, 0\n2, 1, 0, 0\n3, 1, 1, 0\n4, 0, 1, 0\n\
+               5, 0, 0, 1\n6, 1, 0, 1\n7, 1, 1, 1\n8, 0, 1, 1\n\
+               *Element, type=C3D8, elset=E\n1, 1, 2, 3, 4, 5, 6, 7, 8\n";
+    let t = std::time::Instant::now();
+    let text =
+        format!("{hex}*Nset, nset=A, generate\n-9223372036854775808, 9223372036854775807, 1\n");
+    let e = read_bytes("bad.inp", text.as_bytes())
+        .err()
+        .expect("an error");
+    assert!(
+        e.contains(
+            "bad.inp:12: node set `A` lists node -9223372036854775808, which no *Node defines"
+        ),
+        "{e}"
+    );
+    // an element set over the whole range keeps the hexahedra it spans
+    let text =
+        format!("{hex}*Elset, elset=ALL, generate\n-9223372036854775808, 9223372036854775807, 1\n");
+    let m = read_bytes("big.inp", text.as_bytes()).unwrap();
+    assert_eq!(m.mesh.element_sets["ALL"], [0]);
+    // 40 ranges of 1e8 labels each (4e9 ids listed one by one before)
+    let text = format!(
+        "{hex}{}",
+        "*Elset, elset=MANY, generate\n1, 99999999, 1\n".repeat(40)
+    );
+    let m = read_bytes("many.inp", text.as_bytes()).unwrap();
+    assert_eq!(m.mesh.element_sets["MANY"], [0]);
+    // a set that lists itself twice, 60 times over
+    let text = format!(
+        "{hex}*Nset, nset=A\n1, 2\n{}",
+        "*Nset, nset=A\nA, A\n".repeat(60)
+    );
+    let m = read_bytes("twice.inp", text.as_bytes()).unwrap();
+    assert_eq!(m.mesh.node_sets["A"].len(), 2);
+    // a generate range with a step, and the nodes of a range that a *Node does not define
+    let text = format!("{hex}*Nset, nset=ODD, generate\n1, 8, 2\n");
+    let m = read_bytes("odd.inp", text.as_bytes()).unwrap();
+    assert_eq!(m.mesh.node_sets["ODD"].len(), 4);
+    let text = format!("{hex}*Nset, nset=B, generate\n1, 9, 2\n");
+    let e = read_bytes("bad.inp", text.as_bytes())
+        .err()
+        .expect("an error");
+    assert!(e.contains("lists node 9"), "{e}");
+    assert!(t.elapsed().as_secs_f64() < 5.0, "{:?}", t.elapsed());
+}
