@@ -19,7 +19,8 @@ cargo afl config --build >/dev/null 2>&1 || true
 
 targets=("$@")
 if [ ${#targets[@]} -eq 0 ]; then
-    targets=(scene units material campaign nifti vtu vtk model predict_line serve_message deck)
+    targets=(scene units material campaign nifti vtu vtk model predict_line serve_message deck gmsh abaqus stl
+        raw_volume)
 fi
 
 if [ -z "${FUZZ_NO_REPLAY:-}" ]; then

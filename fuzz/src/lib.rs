@@ -24,7 +24,7 @@ pub const MAX_FUZZ_ELEMENTS: f64 = 20_000.0;
 pub const MAX_FUZZ_DRIVER_STEPS: f64 = 20_000.0;
 
 /// The targets, by name: the corpus directory `corpus/<name>/` and the binary of that name.
-pub const TARGETS: [(&str, fn(&[u8])); 11] = [
+pub const TARGETS: [(&str, fn(&[u8])); 15] = [
     ("scene", scene),
     ("units", units),
     ("material", material),
@@ -36,6 +36,10 @@ pub const TARGETS: [(&str, fn(&[u8])); 11] = [
     ("predict_line", predict_line),
     ("serve_message", serve_message),
     ("deck", deck),
+    ("gmsh", gmsh),
+    ("abaqus", abaqus),
+    ("stl", stl),
+    ("raw_volume", raw_volume),
 ];
 
 /// `palpa serve`'s message parser: the binary's own source file, compiled here.
@@ -49,7 +53,7 @@ pub mod protocol;
 pub mod predict_line_src;
 
 /// The harness's scratch directory: one per afl instance (or process), created once, with the
-/// files a fuzzed input may name (`mesh.vtu`, `curve.csv`, `block-mesh.k`).
+/// files a fuzzed input may name (`mesh.vtu`, `curve.csv`, `block-mesh.k`, `hex-nodes.inp`).
 pub fn work_dir() -> &'static Path {
     static DIR: OnceLock<PathBuf> = OnceLock::new();
     DIR.get_or_init(|| {
@@ -58,6 +62,7 @@ pub fn work_dir() -> &'static Path {
         std::fs::create_dir_all(&d).expect("create the fuzz scratch directory");
         std::fs::write(d.join("mesh.vtu"), FIXTURE_VTU).expect("write mesh.vtu");
         std::fs::write(d.join("block-mesh.k"), FIXTURE_DECK_MESH).expect("write block-mesh.k");
+        std::fs::write(d.join("hex-nodes.inp"), FIXTURE_INP_NODES).expect("write hex-nodes.inp");
         std::fs::write(d.join("curve.csv"), "1.0, 0\n1.1, 1 kPa\n1.2, 3 kPa\n")
             .expect("write curve.csv");
         d
@@ -71,6 +76,11 @@ pub fn remove_work_dir() {
 
 /// The mesh the example decks include.
 const FIXTURE_DECK_MESH: &str = include_str!("../../scenes/decks/block-mesh.k");
+
+/// The nodes of a unit cube, as an Abaqus input file that the `abaqus` seed `include.inp`
+/// reads with `*Include, input=hex-nodes.inp`.
+const FIXTURE_INP_NODES: &str = "*Node\n1, 0, 0, 0\n2, 1, 0, 0\n3, 1, 1, 0\n4, 0, 1, 0\n\
+                                 5, 0, 0, 1\n6, 1, 0, 1\n7, 1, 1, 1\n8, 0, 1, 1\n";
 
 /// A small VTU mesh (of the mesh reader tests) that fuzzed scenes may name as `file = "mesh.vtu"`.
 const FIXTURE_VTU: &str = include_str!("../../tests/meshes/vtk-ascii.vtu");
@@ -293,7 +303,7 @@ pub fn vtk(data: &[u8]) {
 }
 
 /// The separator of a model input's files: `model.json`, then `model.safetensors`, then
-/// optionally `view.json`.
+/// optionally `view.json` (and of a raw volume's header and data).
 pub const MODEL_SEPARATOR: &[u8] = b"\n--palpa-fuzz-next-file--\n";
 
 /// Split a model input into its files (see [`MODEL_SEPARATOR`]).
@@ -394,6 +404,94 @@ pub fn deck(data: &[u8]) {
         "deck",
         &r.as_ref().map(|_| ()).map_err(|e| e.errors.join("; ")),
     );
+}
+
+/// A Gmsh mesh (`.msh`, format 4.1, ASCII or binary) read as a mesh.
+pub fn gmsh(data: &[u8]) {
+    if data.len() > MAX_BINARY {
+        return;
+    }
+    verbose(
+        "gmsh",
+        &solver::mesh_io::read_mesh(&scratch_file("in.msh", data), 1.0),
+    );
+}
+
+/// An Abaqus input file (`.inp`) read as a mesh. `*Include` may name only files of the scratch
+/// directory (which holds `hex-nodes.inp`): an input with a `/` or `\` in a keyword line that
+/// mentions `include` is skipped.
+pub fn abaqus(data: &[u8]) {
+    if data.len() > MAX_TEXT {
+        return;
+    }
+    for line in String::from_utf8_lossy(data).lines() {
+        let t = line.trim_start();
+        if t.starts_with('*')
+            && t.to_ascii_lowercase().contains("include")
+            && t.contains(['/', '\\'])
+        {
+            return;
+        }
+    }
+    verbose(
+        "abaqus",
+        &solver::mesh_io::read_mesh(&scratch_file("in.inp", data), 1.0),
+    );
+}
+
+/// An STL surface (ASCII or binary) read as a rigid indenter's shape, as a scene's
+/// `shape = { stl = ... }` is (in mm), then its signed distance at a few points, as contact
+/// queries it.
+pub fn stl(data: &[u8]) {
+    if data.len() > MAX_BINARY {
+        return;
+    }
+    let spec = contact::ShapeSpec::Stl {
+        path: scratch_file("in.stl", data),
+        scale: 1e-3,
+        translate: [0.0; 3],
+    };
+    let r = contact::Shape::from_spec(&spec);
+    verbose("stl", &r);
+    let Ok(shape) = r else { return };
+    if let Some(bb) = shape.aabb() {
+        let mid = std::array::from_fn(|k| 0.5 * (bb.min[k] + bb.max[k]));
+        let out = std::array::from_fn(|k| 2.0 * bb.max[k] - bb.min[k]);
+        for x in [bb.min, bb.max, mid, out] {
+            let _ = shape.signed_distance(x);
+        }
+    }
+}
+
+/// A raw label volume: its JSON header and its raw bytes, joined by the line of
+/// [`MODEL_SEPARATOR`], written as `volume.json` and `volume.raw` and read as `palpa mesh image`
+/// reads it (`solver::voxel::read_volume`), then its label counts. The header's `data` may only
+/// name a file of the scratch directory; an input whose `data` names another is skipped.
+pub fn raw_volume(data: &[u8]) {
+    if data.len() > MAX_BINARY {
+        return;
+    }
+    let files = model_files(data);
+    if let Ok(serde_json::Value::Object(h)) = serde_json::from_slice(files[0]) {
+        if let Some(serde_json::Value::String(name)) = h.get("data") {
+            if !plain_name(name) {
+                return;
+            }
+        }
+    }
+    let json = scratch_file("volume.json", files[0]);
+    let raw = work_dir().join("volume.raw");
+    match files.get(1) {
+        Some(b) => std::fs::write(&raw, b).expect("write volume.raw"),
+        None => {
+            let _ = std::fs::remove_file(&raw);
+        }
+    }
+    let r = solver::voxel::read_volume(&json);
+    verbose("raw_volume", &r);
+    if let Ok(v) = r {
+        let _ = v.label_counts();
+    }
 }
 
 /// Without afl (a plain `cargo build`): run the harness on each file named on the command

@@ -524,3 +524,172 @@ fn a_vtu_with_a_damaged_compressed_header_is_an_error_not_a_panic() {
         "{e}"
     );
 }
+
+/// Read `bytes` as a mesh file named `name` (a temporary file); the error or the mesh.
+fn read_bytes(name: &str, bytes: &[u8]) -> Result<solver::mesh_io::Imported, String> {
+    let dir = tempfile::tempdir().unwrap();
+    let p = dir.path().join(name);
+    std::fs::write(&p, bytes).unwrap();
+    read_mesh(&p, 1.0)
+}
+
+/// One hexahedron in Gmsh 4.1 ASCII, its `$Nodes` and `$Elements` headers given.
+fn one_hex_msh(nodes_header: &str, elements_header: &str) -> String {
+    format!(
+        "$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$Nodes\n{nodes_header}\n3 1 0 8\n1\n2\n3\n4\n5\n6\n7\n8\n\
+         0 0 0\n1 0 0\n1 1 0\n0 1 0\n0 0 1\n1 0 1\n1 1 1\n0 1 1\n$EndNodes\n\
+         $Elements\n{elements_header}\n3 1 5 1\n1 1 2 3 4 5 6 7 8\n$EndElements\n"
+    )
+}
+
+/// Found by the gmsh fuzz target (docs/fuzzing.md): a `$MeshFormat` data size mshio has no
+/// reader for (9 in a binary file) or one too large for its integer (8000000000) made it panic;
+/// both are errors naming the field.
+#[test]
+fn gmsh_with_an_unreadable_data_size_is_an_error_not_a_panic() {
+    for (text, bad) in [
+        (
+            &b"$MeshFormat\n4.1 1 9\n\x01\0\0\0\n$EndMeshFormat\n"[..],
+            "`9`",
+        ),
+        (
+            b"$MeshFormat\n4.1 0 8000000000\n$EndMeshFormat\n",
+            "`8000000000`",
+        ),
+        (b"$MeshFormat\n4.1 2 8\n$EndMeshFormat\n", "file type `2`"),
+    ] {
+        let e = read_bytes("bad.msh", text).err().expect("an error");
+        assert!(e.contains("bad.msh: $MeshFormat") && e.contains(bad), "{e}");
+    }
+    assert_eq!(
+        read_bytes("good.msh", one_hex_msh("1 8 1 8", "1 1 1 1").as_bytes())
+            .unwrap()
+            .mesh
+            .elements
+            .len(),
+        1
+    );
+}
+
+/// Found by the gmsh fuzz target: a `$Nodes` or `$Elements` header stating 0 entries made
+/// mshio subtract 1 from 0 (a panic in debug and test builds); ASCII and binary.
+#[test]
+fn gmsh_section_of_zero_nodes_or_elements_is_an_error_not_a_panic() {
+    let e = read_bytes("bad.msh", one_hex_msh("1 0 1 8", "1 1 1 1").as_bytes())
+        .err()
+        .expect("an error");
+    assert!(
+        e.contains("bad.msh: line 5: the $Nodes section's header states 0 nodes"),
+        "{e}"
+    );
+    let e = read_bytes("bad.msh", one_hex_msh("1 8 1 8", "1 0 1 1").as_bytes())
+        .err()
+        .expect("an error");
+    assert!(
+        e.contains("line 25: the $Elements section's header states 0 elements"),
+        "{e}"
+    );
+    // the binary file with its node count (the second size_t of the header) set to 0
+    let mut b = std::fs::read(file("gmsh-binary.msh")).unwrap();
+    let at = b.windows(8).position(|w| w == b"\n$Nodes\n").unwrap() + 8;
+    b[at + 8..at + 16].copy_from_slice(&0u64.to_le_bytes());
+    let e = read_bytes("bad.msh", &b).err().expect("an error");
+    assert!(
+        e.contains("the $Nodes section's header states 0 nodes"),
+        "{e}"
+    );
+}
+
+/// Found by the gmsh fuzz target: a physical tag of -2^31 in `$Entities` overflowed its
+/// absolute value (a panic in debug and test builds).
+#[test]
+fn gmsh_physical_tag_of_i32_min_is_an_error_not_a_panic() {
+    let text = one_hex_msh("1 8 1 8", "1 1 1 1").replace(
+        "$Nodes",
+        "$Entities\n0 0 0 1\n1 0 0 0 1 1 1 1 -2147483648 0\n$EndEntities\n$Nodes",
+    );
+    let e = read_bytes("bad.msh", text.as_bytes())
+        .err()
+        .expect("an error");
+    assert!(
+        e.contains("$Entities: the volume 1 has the physical tag -2147483648, out of range"),
+        "{e}"
+    );
+}
+
+/// Found while fuzzing gmsh (by reading the reader, not by afl): contiguous node tags that run
+/// past 2^64 overflowed, and a node block giving a tag twice silently lost a node.
+#[test]
+fn gmsh_node_tags_past_2_64_or_given_twice_are_errors() {
+    // contiguous tags from 2^64 - 1: mshio reads the tags (any) and numbers the nodes from the
+    // header's minimum
+    let max = u64::MAX;
+    let text = one_hex_msh(&format!("1 8 {max} {max}"), "1 1 1 1");
+    let e = read_bytes("bad.msh", text.as_bytes())
+        .err()
+        .expect("an error");
+    assert!(
+        e.contains("node tags from 18446744073709551615 run past 2^64"),
+        "{e}"
+    );
+    // sparse tags (1, 1, 3, ...): the block gives tag 1 twice
+    let text = one_hex_msh("1 8 1 20", "1 1 1 1").replace("3 1 0 8\n1\n2\n", "3 1 0 8\n1\n1\n");
+    let e = read_bytes("bad.msh", text.as_bytes())
+        .err()
+        .expect("an error");
+    assert!(e.contains("node block 1 gives a node tag twice"), "{e}");
+}
+
+/// Found while fuzzing abaqus (by reading the reader; afl did not reach it in 5 minutes): a
+/// `generate` line over the whole i64 range overflowed `last - first` (a panic in debug
+/// builds; in release the wrapped count passed the 1e8 limit and the range was listed id by
+/// id, a hang; 40 ranges of 1e8 ids were 4e9), and a set that lists itself doubled at each
+/// `*Nset` (60 lines of 15 bytes, 2^60 ids). Ranges are now kept as ranges and sets hold each
+/// label once.
+#[test]
+fn abaqus_huge_generate_range_or_self_doubling_set_is_an_error_or_cheap_not_a_hang() {
+    let hex = "*Node\n1, 0, 0, 0\n2, 1, 0, 0\n3, 1, 1, 0\n4, 0, 1, 0\n\
+               5, 0, 0, 1\n6, 1, 0, 1\n7, 1, 1, 1\n8, 0, 1, 1\n\
+               *Element, type=C3D8, elset=E\n1, 1, 2, 3, 4, 5, 6, 7, 8\n";
+    let t = std::time::Instant::now();
+    let text =
+        format!("{hex}*Nset, nset=A, generate\n-9223372036854775808, 9223372036854775807, 1\n");
+    let e = read_bytes("bad.inp", text.as_bytes())
+        .err()
+        .expect("an error");
+    assert!(
+        e.contains(
+            "bad.inp:12: node set `A` lists node -9223372036854775808, which no *Node defines"
+        ),
+        "{e}"
+    );
+    // an element set over the whole range keeps the hexahedra it spans
+    let text =
+        format!("{hex}*Elset, elset=ALL, generate\n-9223372036854775808, 9223372036854775807, 1\n");
+    let m = read_bytes("big.inp", text.as_bytes()).unwrap();
+    assert_eq!(m.mesh.element_sets["ALL"], [0]);
+    // 40 ranges of 1e8 labels each (4e9 ids listed one by one before)
+    let text = format!(
+        "{hex}{}",
+        "*Elset, elset=MANY, generate\n1, 99999999, 1\n".repeat(40)
+    );
+    let m = read_bytes("many.inp", text.as_bytes()).unwrap();
+    assert_eq!(m.mesh.element_sets["MANY"], [0]);
+    // a set that lists itself twice, 60 times over
+    let text = format!(
+        "{hex}*Nset, nset=A\n1, 2\n{}",
+        "*Nset, nset=A\nA, A\n".repeat(60)
+    );
+    let m = read_bytes("twice.inp", text.as_bytes()).unwrap();
+    assert_eq!(m.mesh.node_sets["A"].len(), 2);
+    // a generate range with a step, and the nodes of a range that a *Node does not define
+    let text = format!("{hex}*Nset, nset=ODD, generate\n1, 8, 2\n");
+    let m = read_bytes("odd.inp", text.as_bytes()).unwrap();
+    assert_eq!(m.mesh.node_sets["ODD"].len(), 4);
+    let text = format!("{hex}*Nset, nset=B, generate\n1, 9, 2\n");
+    let e = read_bytes("bad.inp", text.as_bytes())
+        .err()
+        .expect("an error");
+    assert!(e.contains("lists node 9"), "{e}");
+    assert!(t.elapsed().as_secs_f64() < 5.0, "{:?}", t.elapsed());
+}

@@ -21,7 +21,7 @@
 //! the physics.
 
 use super::RawMesh;
-use std::collections::BTreeMap;
+use std::collections::{BTreeMap, BTreeSet};
 use std::path::{Path, PathBuf};
 
 struct Line {
@@ -88,6 +88,57 @@ fn keyword(s: &str) -> (String, BTreeMap<String, String>) {
     (name, params)
 }
 
+/// A set's members as the file lists them: labels, and `generate` ranges (first, last,
+/// increment) kept as ranges until the labels are known. Both without repeats, so a set
+/// listing another set (or itself) again and again does not grow, and a range over labels the
+/// file does not define costs nothing.
+#[derive(Clone, Default)]
+struct Members {
+    labels: BTreeSet<i64>,
+    ranges: BTreeSet<(i64, i64, i64)>,
+}
+
+impl Members {
+    fn add(&mut self, other: &Members) {
+        self.labels.extend(&other.labels);
+        self.ranges.extend(&other.ranges);
+    }
+
+    /// The members' indices by `index` (label -> index). `strict`: a label `index` lacks is the
+    /// error (`Err(label)`); otherwise it is left out. Each range is walked label by label only
+    /// while its labels are defined (strict), or over the defined labels it spans.
+    fn resolve(&self, index: &BTreeMap<i64, u32>, strict: bool) -> Result<Vec<u32>, i64> {
+        let mut out = Vec::new();
+        for id in &self.labels {
+            match index.get(id) {
+                Some(&i) => out.push(i),
+                None if strict => return Err(*id),
+                None => {}
+            }
+        }
+        for &(a, b, s) in &self.ranges {
+            if strict {
+                let mut id = a;
+                loop {
+                    out.push(*index.get(&id).ok_or(id)?);
+                    match id.checked_add(s) {
+                        Some(next) if next <= b => id = next,
+                        _ => break,
+                    }
+                }
+            } else {
+                out.extend(
+                    index
+                        .range(a..=b)
+                        .filter(|(&l, _)| (l as i128 - a as i128) % s as i128 == 0)
+                        .map(|(_, &i)| i),
+                );
+            }
+        }
+        Ok(out)
+    }
+}
+
 fn parse(lines: &[Line]) -> Result<RawMesh, String> {
     let at = |l: &Line| format!("{}:{}", l.file.display(), l.no);
     let mut raw = RawMesh::default();
@@ -95,8 +146,10 @@ fn parse(lines: &[Line]) -> Result<RawMesh, String> {
     // The *Element elset of each hexahedron.
     let mut hex_elset: Vec<Option<String>> = Vec::new();
     let mut elem_index: BTreeMap<i64, u32> = BTreeMap::new();
-    let mut nsets: BTreeMap<String, Vec<i64>> = BTreeMap::new();
-    let mut elsets: BTreeMap<String, Vec<i64>> = BTreeMap::new();
+    // The label of each hexahedron.
+    let mut hex_ids: Vec<i64> = Vec::new();
+    let mut nsets: BTreeMap<String, Members> = BTreeMap::new();
+    let mut elsets: BTreeMap<String, Members> = BTreeMap::new();
     let mut sections: Vec<(String, String)> = Vec::new(); // (elset, where)
     let mut parts_seen = 0;
     let mut instances = 0;
@@ -206,8 +259,8 @@ fn parse(lines: &[Line]) -> Result<RawMesh, String> {
                 }
                 if let Some(s) = params.get("nset") {
                     nset_at.entry(s.to_string()).or_insert_with(|| at(l));
-                    let ids: Vec<i64> = data.iter().filter_map(|d| d.1[0].parse().ok()).collect();
-                    nsets.entry(s.to_string()).or_default().extend(ids);
+                    let ids = data.iter().filter_map(|d| d.1[0].parse::<i64>().ok());
+                    nsets.entry(s.to_string()).or_default().labels.extend(ids);
                 }
             }
             "element" => {
@@ -242,6 +295,7 @@ fn parse(lines: &[Line]) -> Result<RawMesh, String> {
                             return Err(format!("{}: element {id} is defined twice", at(d.0)));
                         }
                         raw.hexes.push(h);
+                        hex_ids.push(id);
                         raw.hex_labels.push(format!(
                             "element {id} ({}:{})",
                             d.0.file.display(),
@@ -257,8 +311,8 @@ fn parse(lines: &[Line]) -> Result<RawMesh, String> {
                     }
                 }
                 if let (Some(s), true) = (&elset, hex) {
-                    let ids: Vec<i64> = data.iter().filter_map(|d| d.1[0].parse().ok()).collect();
-                    elsets.entry(s.clone()).or_default().extend(ids);
+                    let ids = data.iter().filter_map(|d| d.1[0].parse::<i64>().ok());
+                    elsets.entry(s.clone()).or_default().labels.extend(ids);
                 }
             }
             "nset" | "elset" => {
@@ -274,7 +328,9 @@ fn parse(lines: &[Line]) -> Result<RawMesh, String> {
                     })?
                     .clone();
                 let generate = params.contains_key("generate");
-                let mut ids = Vec::new();
+                let mut members = Members::default();
+                // the sets this keyword lists, each merged once
+                let mut listed: BTreeSet<&str> = BTreeSet::new();
                 for d in &data {
                     if generate {
                         let a = label(d, 0, "first label")?;
@@ -290,23 +346,22 @@ fn parse(lines: &[Line]) -> Result<RawMesh, String> {
                                 at(d.0)
                             ));
                         }
-                        if (b - a) / s >= 100_000_000 {
-                            return Err(format!(
-                                "{}: generate `{a}, {b}, {s}` lists more than 1e8 ids",
-                                at(d.0)
-                            ));
-                        }
-                        ids.extend((a..=b).step_by(s as usize));
+                        members.ranges.insert((a, b, s));
                     } else {
                         for tok in &d.1 {
                             match tok.parse::<i64>() {
-                                Ok(v) => ids.push(v),
+                                Ok(v) => {
+                                    members.labels.insert(v);
+                                }
                                 Err(_) => {
+                                    if !listed.insert(tok.as_str()) {
+                                        continue;
+                                    }
                                     let sets = if key == "nset" { &nsets } else { &elsets };
-                                    let other = sets.iter().find(|(k, _)| k.eq_ignore_ascii_case(tok)).map(|(_, v)| v.clone()).ok_or_else(|| {
+                                    let other = sets.iter().find(|(k, _)| k.eq_ignore_ascii_case(tok)).map(|(_, v)| v).ok_or_else(|| {
                                         format!("{}: `{tok}` is neither a label nor a set defined above", at(d.0))
                                     })?;
-                                    ids.extend(other);
+                                    members.add(other);
                                 }
                             }
                         }
@@ -318,7 +373,7 @@ fn parse(lines: &[Line]) -> Result<RawMesh, String> {
                 } else {
                     &mut elsets
                 };
-                sets.entry(set).or_default().extend(ids);
+                sets.entry(set).or_default().add(&members);
             }
             "solid section" => {
                 let e = params
@@ -340,52 +395,48 @@ fn parse(lines: &[Line]) -> Result<RawMesh, String> {
         ));
     }
     // Sets: labels -> indices; element sets keep hexahedra only.
-    let find_set = |sets: &BTreeMap<String, Vec<i64>>, name: &str| {
-        sets.iter()
-            .find(|(k, _)| k.eq_ignore_ascii_case(name))
-            .map(|(_, v)| v.clone())
-    };
-    for (name, ids) in &nsets {
-        let mut v = Vec::new();
-        for id in ids {
-            v.push(*node_index.get(id).ok_or_else(|| {
-                let at = nset_at
-                    .get(name)
-                    .map_or(String::new(), |w| format!("{w}: "));
-                format!("{at}node set `{name}` lists node {id}, which no *Node defines")
-            })?);
-        }
+    for (name, m) in &nsets {
+        let v = m.resolve(&node_index, true).map_err(|id| {
+            let at = nset_at
+                .get(name)
+                .map_or(String::new(), |w| format!("{w}: "));
+            format!("{at}node set `{name}` lists node {id}, which no *Node defines")
+        })?;
         raw.node_sets.insert(name.clone(), v);
     }
-    for (name, ids) in &elsets {
-        let v: Vec<u32> = ids
-            .iter()
-            .filter_map(|id| elem_index.get(id).copied())
-            .collect();
+    let mut hex_sets: BTreeMap<&str, Vec<u32>> = BTreeMap::new();
+    for (name, m) in &elsets {
+        let v = m.resolve(&elem_index, false).unwrap_or_default();
         if !v.is_empty() {
-            raw.element_sets.insert(name.clone(), v);
+            raw.element_sets.insert(name.clone(), v.clone());
         }
+        hex_sets.insert(name, v);
     }
     // Parts.
     let mut part_of: Vec<Option<usize>> = vec![None; raw.hexes.len()];
     let mut names: Vec<String> = Vec::new();
     if !sections.is_empty() {
         for (elset, where_) in &sections {
-            let ids = find_set(&elsets, elset).ok_or_else(|| {
-                format!("{where_}: *Solid Section refers to element set `{elset}`, which is not defined")
-            })?;
+            let hexes = hex_sets
+                .iter()
+                .find(|(k, _)| k.eq_ignore_ascii_case(elset))
+                .map(|(_, v)| v)
+                .ok_or_else(|| {
+                    format!("{where_}: *Solid Section refers to element set `{elset}`, which is not defined")
+                })?;
             let key = names.len();
             names.push(elset.clone());
-            for id in ids {
-                if let Some(&e) = elem_index.get(&id) {
-                    if let Some(prev) = part_of[e as usize] {
-                        return Err(format!(
-                            "{where_}: element {id} is in two solid sections (`{}` and `{elset}`)",
-                            names[prev]
-                        ));
+            for &e in hexes {
+                if let Some(prev) = part_of[e as usize] {
+                    if prev == key {
+                        continue;
                     }
-                    part_of[e as usize] = Some(key);
+                    return Err(format!(
+                        "{where_}: element {} is in two solid sections (`{}` and `{elset}`)",
+                        hex_ids[e as usize], names[prev]
+                    ));
                 }
+                part_of[e as usize] = Some(key);
             }
         }
     }

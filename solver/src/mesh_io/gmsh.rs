@@ -13,6 +13,10 @@
 //! skips, is read here (a count, then lines `dimension tag "name"`, ASCII in binary files too).
 //! Files of format 2.2 are refused with the Gmsh option that writes 4.1. Where node tags are
 //! contiguous mshio gives them in file order, which is how Gmsh numbers them.
+//!
+//! Checked here before mshio sees the file, since mshio 0.4 panics on them: the `$MeshFormat`
+//! line's file type (0 or 1) and data size (4 or 8; it reads no other), and the counts of the
+//! `$Nodes` and `$Elements` section headers (it subtracts 1 from them unchecked).
 
 use super::RawMesh;
 use mshio::ElementType;
@@ -31,6 +35,8 @@ pub fn read(path: &Path) -> Result<RawMesh, String> {
              `Mesh.MshFileVersion = 4.1` or use File > Export > Version 4 ASCII)"
         ));
     }
+    let format = mesh_format(&bytes).map_err(|e| format!("{p}: $MeshFormat: {e}"))?;
+    check_section_counts(&bytes, &format).map_err(|e| format!("{p}: {e}"))?;
     let msh = mshio::parse_msh_bytes(&bytes).map_err(|e| {
         let text = e.to_string();
         let short: Vec<&str> = text
@@ -53,38 +59,39 @@ pub fn read(path: &Path) -> Result<RawMesh, String> {
     // Physical tags of each geometric entity, by (dimension, tag).
     let mut groups: BTreeMap<(i32, i32), Vec<i32>> = BTreeMap::new();
     if let Some(ent) = &msh.data.entities {
-        for e in &ent.points {
-            groups.insert(
-                (0, e.tag),
-                e.physical_tags.iter().map(|t| t.abs()).collect(),
-            );
-        }
-        for e in &ent.curves {
-            groups.insert(
-                (1, e.tag),
-                e.physical_tags.iter().map(|t| t.abs()).collect(),
-            );
-        }
-        for e in &ent.surfaces {
-            groups.insert(
-                (2, e.tag),
-                e.physical_tags.iter().map(|t| t.abs()).collect(),
-            );
-        }
-        for e in &ent.volumes {
-            groups.insert(
-                (3, e.tag),
-                e.physical_tags.iter().map(|t| t.abs()).collect(),
-            );
+        let points = ent.points.iter().map(|e| (0, e.tag, &e.physical_tags));
+        let curves = ent.curves.iter().map(|e| (1, e.tag, &e.physical_tags));
+        let surfaces = ent.surfaces.iter().map(|e| (2, e.tag, &e.physical_tags));
+        let volumes = ent.volumes.iter().map(|e| (3, e.tag, &e.physical_tags));
+        for (dim, tag, phys) in points.chain(curves).chain(surfaces).chain(volumes) {
+            let tags = phys
+                .iter()
+                .map(|t| {
+                    t.checked_abs().ok_or_else(|| {
+                        format!(
+                            "{p}: $Entities: the {} {tag} has the physical tag {t}, out of range",
+                            ["point", "curve", "surface", "volume"][dim]
+                        )
+                    })
+                })
+                .collect::<Result<_, _>>()?;
+            groups.insert((dim as i32, tag), tags);
         }
     }
     let mut raw = RawMesh::default();
     let mut index: BTreeMap<u64, u32> = BTreeMap::new();
     if let Some(nodes) = &msh.data.nodes {
         let mut next_tag = nodes.min_node_tag;
-        for b in &nodes.node_blocks {
+        for (k, b) in nodes.node_blocks.iter().enumerate() {
             let tags: Vec<u64> = match &b.node_tags {
                 Some(map) => {
+                    // mshio maps tag -> index: a tag given twice in the block keeps one index
+                    if map.len() != b.nodes.len() {
+                        return Err(format!(
+                            "{p}: $Nodes: node block {} gives a node tag twice",
+                            k + 1
+                        ));
+                    }
                     let mut t = vec![0u64; b.nodes.len()];
                     for (&tag, &i) in map {
                         t[i] = tag;
@@ -92,8 +99,14 @@ pub fn read(path: &Path) -> Result<RawMesh, String> {
                     t
                 }
                 None => {
-                    let t = (next_tag..next_tag + b.nodes.len() as u64).collect();
-                    next_tag += b.nodes.len() as u64;
+                    let end = next_tag.checked_add(b.nodes.len() as u64).ok_or_else(|| {
+                        format!(
+                            "{p}: $Nodes: node tags from {} run past 2^64",
+                            nodes.min_node_tag
+                        )
+                    })?;
+                    let t = (next_tag..end).collect();
+                    next_tag = end;
                     t
                 }
             };
@@ -200,6 +213,113 @@ fn format_version(bytes: &[u8]) -> Option<String> {
     let rest = &bytes[at + 11..];
     let text = String::from_utf8_lossy(&rest[..rest.len().min(64)]);
     text.split_whitespace().next().map(String::from)
+}
+
+/// What the `$MeshFormat` section says of the encoding.
+struct Format {
+    binary: bool,
+    /// Bytes of a `size_t` (counts and tags) in a binary file.
+    size: usize,
+    big_endian: bool,
+}
+
+/// The `$MeshFormat` line `version file-type data-size`, and in a binary file the byte order
+/// (the int 1 on the next line). mshio panics on a data size it has no reader for (other than
+/// 1, 2, 4, 8 or 16 bytes, or too large a number); Gmsh writes 8, and 4 is `size_t` on 32-bit
+/// machines.
+fn mesh_format(bytes: &[u8]) -> Result<Format, String> {
+    let at = find(bytes, b"$MeshFormat").ok_or("missing")? + 11;
+    let rest = &bytes[at..];
+    let start = rest
+        .iter()
+        .position(|&b| b == b'\n')
+        .ok_or("no line break")?
+        + 1;
+    let len = rest[start..]
+        .iter()
+        .position(|&b| b == b'\n')
+        .ok_or("no line break after the format line")?;
+    let line = String::from_utf8_lossy(&rest[start..start + len]);
+    let w: Vec<&str> = line.split_whitespace().collect();
+    let [_, file_type, data_size] = w[..] else {
+        return Err(format!(
+            "the format line `{}` is not `version file-type data-size`",
+            line.trim()
+        ));
+    };
+    let binary = match file_type.parse::<u64>() {
+        Ok(0) => false,
+        Ok(1) => true,
+        _ => return Err(format!("file type `{file_type}`: 0 (ASCII) or 1 (binary)")),
+    };
+    let size = match data_size.parse::<u64>() {
+        Ok(n @ (4 | 8)) => n as usize,
+        _ => {
+            return Err(format!(
+                "data size `{data_size}`: palpa reads 8 (what Gmsh writes) or 4"
+            ))
+        }
+    };
+    let after = &rest[start + len + 1..];
+    let big_endian = binary && after.len() >= 4 && after[..4] == 1i32.to_be_bytes();
+    Ok(Format {
+        binary,
+        size,
+        big_endian,
+    })
+}
+
+/// Refuse a `$Nodes` or `$Elements` section whose header states 0 nodes or elements: mshio
+/// subtracts 1 from the count unchecked (a panic in debug builds, a wrapped count otherwise).
+/// Every line that starts the section is checked (mshio refuses a second one, but only after
+/// reading it).
+fn check_section_counts(bytes: &[u8], f: &Format) -> Result<(), String> {
+    for (tag, what) in [(&b"$Nodes"[..], "nodes"), (b"$Elements", "elements")] {
+        let mut from = 0;
+        while let Some(i) = find(&bytes[from..], tag) {
+            let at = from + i;
+            from = at + tag.len();
+            // mshio's section start: whitespace, the tag, a line break
+            if at > 0 && !bytes[at - 1].is_ascii_whitespace() {
+                continue;
+            }
+            let body = match &bytes[from..] {
+                [b'\n', r @ ..] | [b'\r', b'\n', r @ ..] => r,
+                _ => continue,
+            };
+            let name = String::from_utf8_lossy(tag);
+            let count = if f.binary {
+                let Some(b) = body.get(f.size..2 * f.size) else {
+                    continue;
+                };
+                let v = b.iter().fold(0u128, |v, &x| v << 8 | x as u128);
+                let v_le = b.iter().rev().fold(0u128, |v, &x| v << 8 | x as u128);
+                if f.big_endian {
+                    v
+                } else {
+                    v_le
+                }
+            } else {
+                let text = String::from_utf8_lossy(&body[..body.len().min(256)]);
+                match text.split_whitespace().nth(1).map(str::parse::<u128>) {
+                    Some(Ok(n)) => n,
+                    _ => continue,
+                }
+            };
+            if count == 0 {
+                let line = bytes[..at].iter().filter(|&&b| b == b'\n').count() + 2;
+                let place = if f.binary {
+                    String::new()
+                } else {
+                    format!("line {line}: ")
+                };
+                return Err(format!(
+                    "{place}the {name} section's header states 0 {what}; palpa needs a mesh with {what}"
+                ));
+            }
+        }
+    }
+    Ok(())
 }
 
 /// `$PhysicalNames`: (dimension, tag) -> name.

@@ -49,19 +49,40 @@ pub fn write_raw(vol: &LabelVolume, json_path: &Path) -> Result<PathBuf, String>
     Ok(raw_path)
 }
 
-/// Read a volume written by [`write_raw`].
+/// Read a volume written by [`write_raw`]. The data file's size is checked against `dims`
+/// before it is read.
 pub fn read_raw(json_path: &Path) -> Result<LabelVolume, String> {
-    let s =
-        std::fs::read_to_string(json_path).map_err(|e| format!("{}: {e}", json_path.display()))?;
-    let h: RawHeader =
-        serde_json::from_str(&s).map_err(|e| format!("{}: {e}", json_path.display()))?;
+    let j = json_path.display();
+    let s = std::fs::read_to_string(json_path).map_err(|e| format!("{j}: {e}"))?;
+    let h: RawHeader = serde_json::from_str(&s).map_err(|e| format!("{j}: {e}"))?;
     if h.dtype != "uint8" || h.order != "x-fastest" {
+        return Err(format!("{j}: only uint8, x-fastest data is supported"));
+    }
+    let d = h.dims;
+    if d.contains(&0) {
         return Err(format!(
-            "{}: only uint8, x-fastest data is supported",
-            json_path.display()
+            "{j}: dims {d:?}: a volume needs at least one voxel along each axis"
         ));
     }
+    let n = d
+        .iter()
+        .try_fold(1u64, |n, &k| n.checked_mul(k as u64))
+        .ok_or_else(|| {
+            format!(
+                "{j}: dims {d:?}: {} x {} x {} voxels overflow",
+                d[0], d[1], d[2]
+            )
+        })?;
     let raw_path = json_path.parent().unwrap_or(Path::new(".")).join(&h.data);
-    let labels = std::fs::read(&raw_path).map_err(|e| format!("{}: {e}", raw_path.display()))?;
-    LabelVolume::from_affine(h.dims, h.affine_m, labels)
+    let r = raw_path.display();
+    let size = std::fs::metadata(&raw_path)
+        .map_err(|e| format!("{r}: {e}"))?
+        .len();
+    if size != n {
+        return Err(format!(
+            "{r}: {size} bytes, but the dims {d:?} of {j} need {n} (one byte per voxel)"
+        ));
+    }
+    let labels = std::fs::read(&raw_path).map_err(|e| format!("{r}: {e}"))?;
+    LabelVolume::from_affine(h.dims, h.affine_m, labels).map_err(|e| format!("{j}: {e}"))
 }

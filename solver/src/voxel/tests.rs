@@ -358,3 +358,39 @@ fn a_nifti_whose_bitpix_disagrees_with_its_datatype_is_an_error_not_a_panic() {
     }
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// Found by the raw_volume fuzz target (docs/fuzzing.md): a JSON header whose dims multiply
+/// past `usize` (`[2, 1e19, 1]`) overflowed in `LabelVolume::from_affine` (a panic in debug
+/// builds; in release the wrapped product could match the data and pass absurd dims on). The
+/// header is checked first, and the data file's size against the dims before it is read.
+#[test]
+fn a_raw_volume_whose_dims_overflow_is_an_error_not_a_panic() {
+    let dir = std::env::temp_dir().join(format!("palpa-raw-dims-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let j = dir.join("labels.json");
+    write_raw(&LabelVolume::new([2, 1, 1], [1e-3; 3], [0.0; 3]), &j).unwrap();
+    let good = std::fs::read_to_string(&j).unwrap();
+    let header = |dims: &str| {
+        let v: serde_json::Value = serde_json::from_str(&good).unwrap();
+        let mut v = v.as_object().unwrap().clone();
+        v.insert("dims".into(), serde_json::from_str(dims).unwrap());
+        std::fs::write(&j, serde_json::to_string(&v).unwrap()).unwrap();
+        read_volume(&j).unwrap_err()
+    };
+    let e = header("[2, 10000000000000000000, 1]");
+    assert!(
+        e.contains("labels.json: dims") && e.contains("overflow"),
+        "{e}"
+    );
+    let e = header("[2, 0, 1]");
+    assert!(e.contains("at least one voxel along each axis"), "{e}");
+    let e = header("[2, 2, 1]");
+    assert!(
+        e.contains("labels.raw: 2 bytes, but the dims [2, 2, 1] of") && e.contains("need 4"),
+        "{e}"
+    );
+    // and the library call itself
+    let e = LabelVolume::from_affine([usize::MAX, 2, 1], [[1.0; 4]; 4], vec![0; 2]).unwrap_err();
+    assert!(e.contains("overflows"), "{e}");
+    std::fs::remove_dir_all(&dir).ok();
+}

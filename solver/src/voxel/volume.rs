@@ -42,7 +42,13 @@ impl LabelVolume {
         affine: [[f64; 4]; 4],
         labels: Vec<u8>,
     ) -> Result<Self, String> {
-        if labels.len() != dims[0] * dims[1] * dims[2] {
+        let Some(n) = dims.iter().try_fold(1usize, |n, &d| n.checked_mul(d)) else {
+            return Err(format!(
+                "dims {dims:?} give more voxels than fit in memory ({} x {} x {} overflows)",
+                dims[0], dims[1], dims[2]
+            ));
+        };
+        if labels.len() != n {
             return Err(format!(
                 "label count {} does not match dims {:?}",
                 labels.len(),
