@@ -2,8 +2,9 @@
 
 At each output time of the 400-increment runs: the z reaction of the clamped bottom face and
 of the pressed top face (CalculiX: the RF totals of NBOT and NTOP; palpa: history.csv's
-zmin/zmax reactions, the force the constraint exerts on the body in both), and at the end the
-displacement of the centre node of the face x = SIDE (the bulge; palpa: its last frame).
+zmin/zmax reactions; both the force the constraint exerts on the body, palpa's with the
+constrained nodes' inertia m a, CalculiX's static only), and at the end the displacement of the
+centre node of the face x = SIDE (the bulge; palpa: its last frame).
 """
 import glob
 import os
