@@ -548,18 +548,8 @@ pub fn isochoric_step_at(mesh: &Mesh, parts: &[Part], u: &[[f64; 3]]) -> f64 {
 /// Smallest initial `kappa L / c` over the mesh (s), without mass scaling. Inverted elements
 /// are skipped here (the model build reports them).
 fn natural_step(mesh: &Mesh, parts: &[Part]) -> f64 {
-    let props: Vec<(f64, f64)> = parts.iter().map(|p| step_constants(&p.material)).collect();
-    let mut dt = f64::INFINITY;
-    for (e, conn) in mesh.elements.iter().enumerate() {
-        let x: [[f64; 3]; 8] = std::array::from_fn(|a| mesh.nodes[conn[a] as usize]);
-        if let (Ok(geo), Some(&(c0, kappa))) = (
-            element_geometry(&x),
-            props.get(mesh.element_part[e] as usize),
-        ) {
-            dt = dt.min(kappa * initial_element_dt(&x, geo.volume, c0));
-        }
-    }
-    dt
+    // undisplaced, every element keeps its volume: the isochoric factor is exactly 1
+    isochoric_step_at(mesh, parts, &vec![[0.0; 3]; mesh.nodes.len()])
 }
 
 impl Model {

@@ -137,6 +137,25 @@ fn fits_are_deterministic_for_a_seed() {
     assert_eq!(a.params, b.params);
 }
 
+/// Save a trained model into `dir` and load it back as `palpa predict` does.
+fn save_and_load(
+    model: &TrainedModel,
+    d: &surrogate::Dataset,
+    report: &surrogate::report::TrainReport,
+    dir: &std::path::Path,
+) -> Predictor {
+    let path = dir.join("model.safetensors");
+    model
+        .save(
+            &path,
+            d.roi_ids.as_slice().unwrap(),
+            d.roi_centroids.view(),
+            report,
+        )
+        .unwrap();
+    Predictor::load(&path).unwrap()
+}
+
 fn assert_round_trip(kind: ModelKind, opts: &TrainOptions) {
     let dir = tempfile::tempdir().unwrap();
     let d = make_synthetic_dataset(R);
@@ -145,16 +164,7 @@ fn assert_round_trip(kind: ModelKind, opts: &TrainOptions) {
         // the synthetic targets are smooth: the output basis is in use, and saved with the model
         assert!(g.basis.is_some(), "{report}");
     }
-    let path = dir.path().join("model.safetensors");
-    model
-        .save(
-            &path,
-            d.roi_ids.as_slice().unwrap(),
-            d.roi_centroids.view(),
-            &report,
-        )
-        .unwrap();
-    let mut loaded = Predictor::load(&path).unwrap();
+    let mut loaded = save_and_load(&model, &d, &report, dir.path());
     assert_eq!(loaded.meta().report, report);
     assert_eq!(loaded.roi_centroids(), d.roi_centroids.view());
     let mut direct = model.to_predictor();
@@ -450,16 +460,7 @@ fn a_model_whose_fit_is_nan_saves_and_loads() {
         .unwrap();
     assert!(nan.fit.is_nan(), "{report}");
     let dir = tempfile::tempdir().unwrap();
-    let path = dir.path().join("model.safetensors");
-    model
-        .save(
-            &path,
-            d.roi_ids.as_slice().unwrap(),
-            d.roi_centroids.view(),
-            &report,
-        )
-        .unwrap();
-    let loaded = Predictor::load(&path).unwrap();
+    let loaded = save_and_load(&model, &d, &report, dir.path());
     let back = &loaded.meta().report;
     let fit = |r: &surrogate::report::TrainReport| -> Vec<f64> {
         r.test_fit_by_location.iter().map(|l| l.fit).collect()
