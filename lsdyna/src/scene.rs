@@ -1161,6 +1161,9 @@ fn build(cx: &mut Ctx, path: &Path) -> Result<SceneDef, Vec<String>> {
             loads,
             initial_velocity,
             dt_factor,
+            // LS-DYNA chooses its precision by executable, not by keyword: a deck runs in
+            // f64 unless the command line asks otherwise.
+            precision: solver::element::precision::Precision::F64,
             dt_max,
             dt_min,
             max_steps: None,

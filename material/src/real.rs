@@ -70,6 +70,17 @@ pub trait Real:
     type Mask: Mask;
     /// Number of lanes.
     const LANES: usize;
+    /// The number type laws are evaluated in for a kernel over `Self`: `Self` itself, except for
+    /// the single-precision lanes ([`crate::real_f32::F32x8`]), whose laws run in [`F64x8`].
+    type Wide: Real;
+    /// True where `Self` holds fewer digits than [`Real::Wide`] (single precision).
+    const NARROW: bool = false;
+    /// To the law's number type (exact).
+    fn widen(self) -> Self::Wide;
+    /// From the law's number type (rounded to nearest where `Self` is narrower).
+    fn narrow(w: Self::Wide) -> Self;
+    /// A mask of the law's number type as a mask of `Self`.
+    fn narrow_mask(m: <Self::Wide as Real>::Mask) -> Self::Mask;
     /// The same value in every lane.
     fn splat(x: f64) -> Self;
     /// Lane `i`.
@@ -137,6 +148,19 @@ impl Mask for bool {
 impl Real for f64 {
     type Mask = bool;
     const LANES: usize = 1;
+    type Wide = f64;
+    #[inline(always)]
+    fn widen(self) -> f64 {
+        self
+    }
+    #[inline(always)]
+    fn narrow(w: f64) -> Self {
+        w
+    }
+    #[inline(always)]
+    fn narrow_mask(m: bool) -> bool {
+        m
+    }
     #[inline(always)]
     fn splat(x: f64) -> Self {
         x
@@ -352,6 +376,19 @@ impl Neg for F64x8 {
 impl Real for F64x8 {
     type Mask = M8;
     const LANES: usize = LANES;
+    type Wide = F64x8;
+    #[inline(always)]
+    fn widen(self) -> F64x8 {
+        self
+    }
+    #[inline(always)]
+    fn narrow(w: F64x8) -> Self {
+        w
+    }
+    #[inline(always)]
+    fn narrow_mask(m: M8) -> M8 {
+        m
+    }
     #[inline(always)]
     fn splat(x: f64) -> Self {
         F64x8(f64x8::splat(x))

@@ -26,9 +26,11 @@
 //! by element in element order, both by [`ElementTotals::combine`], for the same reason.
 
 use crate::element::physical::PhysicalRef;
+use crate::element::precision::{NarrowRef, Precision};
 use crate::element::{fault_error, full, one_point, ElementOut, Formulation, Nodal, StepInput};
 use crate::model::{ChunkOut, ElementTotals, Group, Part, CHUNK};
 use material::real::{F64x8, Mask, Real, LANES};
+use material::real_f32::F32x8;
 use material::{with_law, Law};
 use rayon::prelude::*;
 use std::sync::OnceLock;
@@ -124,6 +126,16 @@ pub fn element_loop(
     for g in groups.iter_mut() {
         let part = &parts[g.part];
         let n = g.elements.len();
+        if input.precision == Precision::F32 && g.narrow.is_none() {
+            g.narrow = Some(Box::new(NarrowRef::new(
+                &g.grad,
+                &g.gamma,
+                &g.hg_frame,
+                &g.hg_inv_len,
+                &g.gp_grad,
+                &g.gp_weight,
+            )));
+        }
         let mut chunks = std::mem::take(&mut g.chunks);
         let chunk_ptr = Shared(chunks.as_mut_ptr());
         let hist = Shared(g.history.as_mut_ptr());
@@ -178,21 +190,116 @@ pub fn element_loop(
     Ok(tot)
 }
 
-/// One chunk of batches, with the instruction set of [`simd_level`].
+/// One chunk of batches, in the run's precision.
 fn run_chunk<L: Law>(l: &L, b: &Batch, ci: usize) -> ChunkOut {
+    match b.input.precision {
+        Precision::F64 => run_chunk_in::<L, F64x8>(l, b, ci),
+        Precision::F32 => run_chunk_in::<L, F32x8>(l, b, ci),
+    }
+}
+
+/// One chunk of batches with kernels over `R`, with the instruction set of [`simd_level`].
+fn run_chunk_in<L: Law, R: KernelLanes>(l: &L, b: &Batch, ci: usize) -> ChunkOut {
     #[cfg(target_arch = "x86_64")]
     if simd_level() == "avx512" {
         // SAFETY: the processor has the features (checked by `simd_level`).
-        return unsafe { run_chunk_avx512(l, b, ci) };
+        return unsafe { run_chunk_avx512::<L, R>(l, b, ci) };
     }
-    run_chunk_body::<L, ScalarGather>(l, b, ci)
+    run_chunk_body::<L, ScalarGather, R>(l, b, ci)
 }
 
 /// [`run_chunk_body`] compiled for AVX-512.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx512f,avx512dq,avx512vl,avx512bw")]
-unsafe fn run_chunk_avx512<L: Law>(l: &L, b: &Batch, ci: usize) -> ChunkOut {
-    run_chunk_body::<L, Avx512Gather>(l, b, ci)
+unsafe fn run_chunk_avx512<L: Law, R: KernelLanes>(l: &L, b: &Batch, ci: usize) -> ChunkOut {
+    run_chunk_body::<L, Avx512Gather, R>(l, b, ci)
+}
+
+/// The number types the element kernels run in ([`F64x8`], [`F32x8`]), and where each finds
+/// its reference data: the group's own (`f64`) or its [`NarrowRef`] (`f32`).
+trait KernelLanes: Real<Wide = F64x8> {
+    fn grad(g: &Group) -> &[Nodal<Self>];
+    fn gamma(g: &Group) -> &[[[Self; 8]; 4]];
+    fn hg_frame(g: &Group) -> &[[[Self; 3]; 3]];
+    fn hg_inv_len(g: &Group) -> &[[Self; 3]];
+    fn gp_grad(g: &Group) -> &[[Nodal<Self>; 8]];
+    fn gp_weight(g: &Group) -> &[[Self; 8]];
+    /// A batch's nodal field in the kernel's number type: as it is in `f64`; relative to each
+    /// element's first node before rounding in `f32` (see [`crate::element::precision`]).
+    fn nodal(x: &Nodal<F64x8>) -> Nodal<Self>;
+}
+
+impl KernelLanes for F64x8 {
+    #[inline(always)]
+    fn grad(g: &Group) -> &[Nodal<Self>] {
+        &g.grad
+    }
+    #[inline(always)]
+    fn gamma(g: &Group) -> &[[[Self; 8]; 4]] {
+        &g.gamma
+    }
+    #[inline(always)]
+    fn hg_frame(g: &Group) -> &[[[Self; 3]; 3]] {
+        &g.hg_frame
+    }
+    #[inline(always)]
+    fn hg_inv_len(g: &Group) -> &[[Self; 3]] {
+        &g.hg_inv_len
+    }
+    #[inline(always)]
+    fn gp_grad(g: &Group) -> &[[Nodal<Self>; 8]] {
+        &g.gp_grad
+    }
+    #[inline(always)]
+    fn gp_weight(g: &Group) -> &[[Self; 8]] {
+        &g.gp_weight
+    }
+    #[inline(always)]
+    fn nodal(x: &Nodal<F64x8>) -> Nodal<Self> {
+        *x
+    }
+}
+
+/// The group's [`NarrowRef`], which [`element_loop`] builds before an `f32` step.
+#[inline(always)]
+fn narrow_ref(g: &Group) -> &NarrowRef {
+    g.narrow
+        .as_deref()
+        .expect("element_loop builds the f32 reference data first")
+}
+
+impl KernelLanes for F32x8 {
+    #[inline(always)]
+    fn grad(g: &Group) -> &[Nodal<Self>] {
+        &narrow_ref(g).grad
+    }
+    #[inline(always)]
+    fn gamma(g: &Group) -> &[[[Self; 8]; 4]] {
+        &narrow_ref(g).gamma
+    }
+    #[inline(always)]
+    fn hg_frame(g: &Group) -> &[[[Self; 3]; 3]] {
+        &narrow_ref(g).hg_frame
+    }
+    #[inline(always)]
+    fn hg_inv_len(g: &Group) -> &[[Self; 3]] {
+        &narrow_ref(g).hg_inv_len
+    }
+    #[inline(always)]
+    fn gp_grad(g: &Group) -> &[[Nodal<Self>; 8]] {
+        &narrow_ref(g).gp_grad
+    }
+    #[inline(always)]
+    fn gp_weight(g: &Group) -> &[[Self; 8]] {
+        &narrow_ref(g).gp_weight
+    }
+    #[inline(always)]
+    fn nodal(x: &Nodal<F64x8>) -> Nodal<Self> {
+        material::arr![3, |i| {
+            let x0 = x[i][0];
+            material::arr![8, |a| F32x8::narrow(x[i][a] - x0)]
+        }]
+    }
 }
 
 /// Lane vector of per-element values `x[le0 + lane]`, lanes past `n` repeating the last.
@@ -203,7 +310,7 @@ fn lanes_of(x: &[f64], le0: usize) -> F64x8 {
 }
 
 #[inline(always)]
-fn run_chunk_body<L: Law, G: GatherLanes>(l: &L, b: &Batch, ci: usize) -> ChunkOut {
+fn run_chunk_body<L: Law, G: GatherLanes, R: KernelLanes>(l: &L, b: &Batch, ci: usize) -> ChunkOut {
     let g = b.group;
     let n = g.elements.len();
     let stride = g.history_stride;
@@ -220,25 +327,27 @@ fn run_chunk_body<L: Law, G: GatherLanes>(l: &L, b: &Batch, ci: usize) -> ChunkO
         let ve = G::lanes(b.v, &conn);
         let xr = G::lanes(b.x_ref, &conn);
         let xe: Nodal<F64x8> = material::arr![3, |i| material::arr![8, |a| xr[i][a] + ue[i][a]]];
-        let mut fe: Nodal<F64x8> = [[F64x8::zero(); 8]; 3];
+        let (ue, ve, xe) = (R::nodal(&ue), R::nodal(&ve), R::nodal(&xe));
+        let mut fe: Nodal<R> = [[R::zero(); 8]; 3];
         let fe = &mut fe;
-        let s = if g.density_scale.is_empty() {
+        let s64 = if g.density_scale.is_empty() {
             F64x8::splat(1.0)
         } else {
             lanes_of(&g.density_scale, le0)
         };
+        let s = R::narrow(s64);
         // SAFETY: batch bi owns history[bi*stride..(bi+1)*stride] alone.
         let h = unsafe { b.hist.slice(bi * stride, stride) };
-        let o: ElementOut<F64x8> = match b.form {
+        let o: ElementOut<R> = match b.form {
             Formulation::OnePoint(hg) => {
                 let rf = one_point::OnePointRef {
-                    grad: &g.grad[bi],
-                    gamma: &g.gamma[bi],
-                    vol0: lanes_of(&g.vol0, le0),
-                    hg_scale: lanes_of(&g.hg_scale, le0),
+                    grad: &R::grad(g)[bi],
+                    gamma: &R::gamma(g)[bi],
+                    vol0: R::narrow(lanes_of(&g.vol0, le0)),
+                    hg_scale: R::narrow(lanes_of(&g.hg_scale, le0)),
                     physical: (!g.hg_frame.is_empty()).then(|| PhysicalRef {
-                        frame: &g.hg_frame[bi],
-                        inv_len: &g.hg_inv_len[bi],
+                        frame: &R::hg_frame(g)[bi],
+                        inv_len: &R::hg_inv_len(g)[bi],
                         young: g.hg_moduli[0],
                         poisson: g.hg_moduli[1],
                         shear: g.hg_moduli[2],
@@ -248,25 +357,22 @@ fn run_chunk_body<L: Law, G: GatherLanes>(l: &L, b: &Batch, ci: usize) -> ChunkO
             }
             Formulation::Full { fbar } => {
                 let rf = full::FullRef {
-                    centre_grad: &g.grad[bi],
-                    gp_grad: &g.gp_grad[bi],
-                    gp_weight: &g.gp_weight[bi],
-                    vol0: lanes_of(&g.vol0, le0),
+                    centre_grad: &R::grad(g)[bi],
+                    gp_grad: &R::gp_grad(g)[bi],
+                    gp_weight: &R::gp_weight(g)[bi],
+                    vol0: R::narrow(lanes_of(&g.vol0, le0)),
                 };
                 full::compute_forces(l, &rf, fbar, &xe, &ue, &ve, s, b.input, h, fe)
             }
         };
-        let (fault_l, fault_v) = (o.fault.to_array(), o.fault_value.to_array());
+        let f64s = |x: R| x.widen().to_array();
+        let (fault_l, fault_v) = (f64s(o.fault), f64s(o.fault_value));
         let (dt_l, hs_l, hp_l) = (
-            o.dt.to_array(),
-            o.hourglass_stored.to_array(),
-            o.hourglass_power.to_array(),
+            f64s(o.dt),
+            f64s(o.hourglass_stored),
+            f64s(o.hourglass_power),
         );
-        let (bulk_l, diss_l, s_l) = (
-            o.bulk_power.to_array(),
-            o.law_dissipation.to_array(),
-            s.to_array(),
-        );
+        let (bulk_l, diss_l, s_l) = (f64s(o.bulk_power), f64s(o.law_dissipation), s64.to_array());
         let mut add = [false; LANES];
         for q in 0..nvalid {
             let le = le0 + q;
@@ -314,7 +420,7 @@ fn run_chunk_body<L: Law, G: GatherLanes>(l: &L, b: &Batch, ci: usize) -> ChunkO
         }
         // Add the batch's forces into the nodal array, element by element.
         let fl: [[[f64; LANES]; 8]; 3] =
-            material::arr![3, |i| material::arr![8, |a| fe[i][a].to_array()]];
+            material::arr![3, |i| material::arr![8, |a| fe[i][a].widen().to_array()]];
         for q in 0..nvalid {
             if !add[q] {
                 continue;

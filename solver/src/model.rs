@@ -15,6 +15,7 @@
 //! (dt_t / (s_f L/c))^2, which raises its step to exactly dt_t; other elements are untouched.
 //! The added mass is reported per part.
 
+use crate::element::precision::NarrowRef;
 use crate::element::{max_face_area, Nodal};
 use crate::element::{physical, surface_mode_factor, Formulation, HourglassForm, HourglassModulus};
 use crate::hex::{element_geometry, hourglass_gamma};
@@ -252,6 +253,9 @@ pub struct Group {
     pub lumped: Vec<[f64; 8]>,
     /// The group's hourglass energy, for the summary's warning that names the part.
     pub hourglass: GroupHourglass,
+    /// The reference data in `f32` lanes, built the first time an `f32` run evaluates the
+    /// group ([`crate::element::precision`]).
+    pub narrow: Option<Box<NarrowRef>>,
 }
 
 /// A group's hourglass energy: the stiffness form's stored energy and the viscous form's power
@@ -615,6 +619,7 @@ impl Model {
                 hg_frame: Vec::new(),
                 hg_inv_len: Vec::new(),
                 hg_moduli: [0.0; 3],
+                narrow: None,
                 gp_grad: Vec::new(),
                 gp_weight: Vec::new(),
                 history_stride: stride,

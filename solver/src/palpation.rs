@@ -234,6 +234,8 @@ pub struct PalpationSetup {
     pub max_bulk_ratio: Option<f64>,
     /// The preset the knobs came from (stated in the summary).
     pub fidelity: Fidelity,
+    /// The element kernels' number type (`[run] precision`).
+    pub precision: crate::element::precision::Precision,
     /// Write VTK frames.
     pub vtk: bool,
 }
@@ -261,6 +263,7 @@ impl Default for PalpationSetup {
             dt_factor: crate::simulation::DEFAULT_DT_FACTOR,
             max_bulk_ratio: None,
             fidelity: Fidelity::Standard,
+            precision: Default::default(),
             vtk: true,
         }
     }
@@ -354,8 +357,11 @@ impl PalpationSetup {
         );
         let _ = writeln!(
             s,
-            "[run]\ntitle = {:?}\nend_time = \"{} s\"\ndt_factor = {}\n",
-            self.title, self.duration, self.dt_factor
+            "[run]\ntitle = {:?}\nend_time = \"{} s\"\ndt_factor = {}\nprecision = {:?}\n",
+            self.title,
+            self.duration,
+            self.dt_factor,
+            self.precision.label()
         );
         let _ = writeln!(
             s,

@@ -78,6 +78,8 @@ pub struct RunSummary {
     pub hourglass_energy: f64,
     /// Final external work (J).
     pub external_work: f64,
+    /// The element kernels' number type (`f64` or `f32`).
+    pub precision: String,
     /// Active stages.
     pub active_stages: Vec<String>,
     /// Time per stage.
@@ -557,6 +559,7 @@ pub fn run_scene(
         internal_energy: e.internal,
         hourglass_energy: e.hourglass,
         external_work: e.external,
+        precision: sim.settings.precision.label().into(),
         active_stages: sim.active_stages(),
         stage_times,
         mass: sim

@@ -22,6 +22,7 @@
 //! relaxation are `Option`s decided at construction.
 
 use crate::bc::{Constraint, Kinematic, NodalLoad};
+use crate::element::precision::Precision;
 use crate::element::{BulkViscosity, StepInput};
 use crate::forces::element_loop;
 use crate::model::{ElementTotals, Model, SolverError};
@@ -185,6 +186,8 @@ pub struct LoopSettings {
     pub dt_min: f64,
     /// Stop the run when hourglass energy passes a share of the internal energy.
     pub hourglass_limit: Option<HourglassLimit>,
+    /// The element kernels' number type (default `f64`).
+    pub precision: Precision,
 }
 
 /// The hourglass guard: a run whose hourglass energy exceeds `ratio` x internal energy at any
@@ -210,6 +213,7 @@ impl Default for LoopSettings {
             dt_max: f64::INFINITY,
             dt_min: 0.0,
             hourglass_limit: None,
+            precision: Precision::F64,
         }
     }
 }
@@ -489,6 +493,7 @@ impl Simulation {
             dt: self.dt_prev,
             bulk: self.settings.bulk,
             want_stress,
+            precision: self.settings.precision,
         };
         let t0 = Instant::now();
         let stress = if want_stress {

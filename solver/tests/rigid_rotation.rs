@@ -53,6 +53,7 @@ fn max_stress(form: Formulation) -> f64 {
         dt: 1e-6,
         bulk: None,
         want_stress: true,
+        precision: Default::default(),
     };
     let Model { parts, groups, .. } = &mut model;
     element_loop(

@@ -26,6 +26,7 @@
 //! that roof the case reaches. The bytes are a count of the arrays the step touches, not a
 //! hardware measurement: cache reuse of the gathered nodal data can beat the roof.
 
+use solver::element::precision::Precision;
 use solver::scene::build::build_scene;
 use solver::scene::SceneSpec;
 use std::path::Path;
@@ -48,7 +49,7 @@ fix = ["all"]
 vtk = false
 "#;
 
-fn case_scene(case: &str) -> Result<String, String> {
+fn case_scene(case: &str, precision: Precision) -> Result<String, String> {
     let nh = r#"
 [materials.nh]
 law = "neo_hookean"
@@ -100,7 +101,8 @@ surface = "zmax"
         }
     };
     Ok(format!(
-        "[run]\ntitle = \"bench {case}\"\nend_time = \"1 s\"\n{BLOCK}{body}"
+        "[run]\ntitle = \"bench {case}\"\nend_time = \"1 s\"\nprecision = \"{}\"\n{BLOCK}{body}",
+        precision.label()
     ))
 }
 
@@ -144,11 +146,23 @@ fn triad_bandwidth() -> f64 {
 fn step_bytes_per_element(m: &solver::model::Model) -> f64 {
     let mut bytes = 0usize;
     for g in &m.groups {
+        // An f32 run reads its reference data from the group's f32 copy.
+        let reference = match g.narrow.as_deref() {
+            Some(n) => {
+                std::mem::size_of_val(n.grad.as_slice())
+                    + std::mem::size_of_val(n.gamma.as_slice())
+                    + std::mem::size_of_val(n.gp_grad.as_slice())
+                    + std::mem::size_of_val(n.gp_weight.as_slice())
+            }
+            None => {
+                std::mem::size_of_val(g.grad.as_slice())
+                    + std::mem::size_of_val(g.gamma.as_slice())
+                    + std::mem::size_of_val(g.gp_grad.as_slice())
+                    + std::mem::size_of_val(g.gp_weight.as_slice())
+            }
+        };
         bytes += g.conn.len() * (32 + 8 + 8)
-            + std::mem::size_of_val(g.grad.as_slice())
-            + std::mem::size_of_val(g.gamma.as_slice())
-            + std::mem::size_of_val(g.gp_grad.as_slice())
-            + std::mem::size_of_val(g.gp_weight.as_slice())
+            + reference
             + 2 * std::mem::size_of_val(g.history.as_slice())
             + 8 * g.density_scale.len();
     }
@@ -156,8 +170,13 @@ fn step_bytes_per_element(m: &solver::model::Model) -> f64 {
     bytes as f64 / m.mesh.elements.len() as f64
 }
 
-fn measure(case: &str, threads: usize, steps: usize) -> Result<Measured, String> {
-    let src = case_scene(case)?;
+fn measure(
+    case: &str,
+    threads: usize,
+    steps: usize,
+    precision: Precision,
+) -> Result<Measured, String> {
+    let src = case_scene(case, precision)?;
     let spec: SceneSpec = toml::from_str(&src).map_err(|e| format!("bench scene {case}: {e}"))?;
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(threads)
@@ -193,7 +212,16 @@ fn measure(case: &str, threads: usize, steps: usize) -> Result<Measured, String>
 }
 
 /// Run the benchmark cases and print the table.
-pub fn bench(cases: &[String], threads: &[usize], steps: usize) -> Result<(), String> {
+pub fn bench(
+    cases: &[String],
+    threads: &[usize],
+    steps: usize,
+    precisions: &[String],
+) -> Result<(), String> {
+    let precisions = precisions
+        .iter()
+        .map(|p| Precision::parse(p).map_err(|e| format!("--precision: {e}")))
+        .collect::<Result<Vec<_>, _>>()?;
     if steps == 0 {
         return Err("--steps must be at least 1".into());
     }
@@ -202,12 +230,13 @@ pub fn bench(cases: &[String], threads: &[usize], steps: usize) -> Result<(), St
     }
     println!(
         "palpa bench: {steps} steps per case, element-cycles per second = elements x steps / wall time; \
-         element kernels: {} (8 lanes of f64)",
+         element kernels: {} (8 lanes)",
         solver::forces::simd_level()
     );
     println!(
-        "{:<8} {:>7} {:>9} {:>9} {:>12} {:>8} {:>7} {:>9} {:>10} {:>7}  stage shares",
+        "{:<8} {:>4} {:>7} {:>9} {:>9} {:>12} {:>8} {:>7} {:>9} {:>10} {:>7}  stage shares",
         "case",
+        "prec",
         "threads",
         "elements",
         "wall s",
@@ -218,10 +247,13 @@ pub fn bench(cases: &[String], threads: &[usize], steps: usize) -> Result<(), St
         "roof M/s",
         "of roof"
     );
-    for case in cases {
+    for (case, p) in cases
+        .iter()
+        .flat_map(|c| precisions.iter().map(move |p| (c, *p)))
+    {
         let mut base = None;
         for &t in threads {
-            let m = measure(case, t, steps)?;
+            let m = measure(case, t, steps, p)?;
             let rate = (m.elements * steps) as f64 / m.seconds;
             let speedup = match base {
                 None => {
@@ -237,7 +269,8 @@ pub fn bench(cases: &[String], threads: &[usize], steps: usize) -> Result<(), St
                 .collect();
             let roof = m.bandwidth / m.bytes_per_element;
             println!(
-                "{case:<8} {t:>7} {:>9} {:>9.3} {:>12.3} {:>8.2} {:>7.0} {:>10.1} {:>10.1} {:>6.0} %  {}",
+                "{case:<8} {:>4} {t:>7} {:>9} {:>9.3} {:>12.3} {:>8.2} {:>7.0} {:>10.1} {:>10.1} {:>6.0} %  {}",
+                p.label(),
                 m.elements,
                 m.seconds,
                 rate / 1e6,
@@ -260,9 +293,9 @@ mod tests {
     #[test]
     fn every_case_scene_parses() {
         for c in ["nh-1pt", "nh-fbar", "press", "ogden"] {
-            let src = case_scene(c).unwrap();
+            let src = case_scene(c, Precision::F32).unwrap();
             let _: SceneSpec = toml::from_str(&src).unwrap();
         }
-        assert!(case_scene("nope").is_err());
+        assert!(case_scene("nope", Precision::F64).is_err());
     }
 }

@@ -152,6 +152,9 @@ enum Command {
         /// Explicit steps per case.
         #[arg(long, default_value_t = 100)]
         steps: usize,
+        /// Element-kernel precisions to compare: f64, f32 or both (`f64,f32`).
+        #[arg(long, value_delimiter = ',', default_values_t = ["f64".to_string()])]
+        precision: Vec<String>,
     },
 }
 
@@ -223,6 +226,7 @@ pub fn dispatch(cli: Cli) -> Result<(), String> {
             cases,
             threads,
             steps,
-        } => bench::bench(&cases, &threads, steps),
+            precision,
+        } => bench::bench(&cases, &threads, steps, &precision),
     }
 }

@@ -79,6 +79,10 @@ pub struct PalpateArgs {
     /// error against F-bar elements is printed with the summary and in docs/palpate.md).
     #[arg(long, default_value = "standard")]
     pub fidelity: String,
+    /// Number type of the element kernels: f64 (default) or f32 (single-precision kernels; the
+    /// laws, history and nodal state stay f64; measured cost in docs/performance.md).
+    #[arg(long, default_value = "f64")]
+    pub precision: String,
     /// Skip the VTK frames.
     #[arg(long)]
     pub no_vtk: bool,
@@ -145,6 +149,8 @@ impl PalpateArgs {
         }
         fidelity.apply(&mut s);
         s.fidelity = fidelity;
+        s.precision = solver::element::precision::Precision::parse(&self.precision)
+            .map_err(|e| format!("--precision: {e}"))?;
         s.vtk = !self.no_vtk;
         s.title = match &s.place {
             Place::Named(n) => format!("palpation at {n}"),

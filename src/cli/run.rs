@@ -30,8 +30,17 @@ pub fn print_summary(s: &RunSummary) {
         s.element_cycles_per_second / 1e6
     );
     println!(
-        "  {} elements, {} nodes; dt {:.4e} .. {:.4e} s",
-        s.elements, s.nodes, s.dt_min, s.dt_max
+        "  {} elements, {} nodes; dt {:.4e} .. {:.4e} s; element kernels in {}{}",
+        s.elements,
+        s.nodes,
+        s.dt_min,
+        s.dt_max,
+        s.precision,
+        if s.precision == "f32" {
+            " (laws, history and nodal state in f64)"
+        } else {
+            ""
+        }
     );
     println!(
         "  energy: kinetic {:.4e} J, internal {:.4e} J, hourglass {:.4e} J, external work {:.4e} J; error {} (largest over the run {} of its largest energy)",

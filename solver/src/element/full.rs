@@ -14,8 +14,9 @@
 //! Without F-bar: f_a = sum_gp w detJ P g_a.
 
 use super::{
-    add_nodal_forces, all_finite, bulk_pressure, critical_step, deformation_gradient,
-    gradient_rate, max_face_area, sym6, ElementOut, Nodal, StepInput, FAULT_DISTORTED, FAULT_FORCE,
+    add_nodal_forces, all_finite, bulk_pressure, critical_step, gradient_rate, max_face_area,
+    narrow3, sym6, wide_deformation_gradient, ElementOut, Nodal, StepInput, FAULT_DISTORTED,
+    FAULT_FORCE,
 };
 use material::real::Real;
 use material::tensor::{cofactor, ddot, det, mul, mul_bt, scale, M3};
@@ -56,13 +57,17 @@ pub fn compute_forces<R: Real, L: Law>(
     v: &Nodal<R>,
     density_scale: R,
     input: &StepInput,
-    history: &mut [R],
+    history: &mut [R::Wide],
     fe: &mut Nodal<R>,
 ) -> ElementOut<R> {
+    // The kinematics (F0, F, J0, J, F-bar) and the law run in the law's number type, the
+    // gradients, force sums and stress averages in the kernel's.
     let hl = law.history_len();
     let one = R::splat(1.0);
-    let f0 = deformation_gradient(u, r.centre_grad);
-    let j0 = det(&f0);
+    let one_w = R::Wide::splat(1.0);
+    let f0w = wide_deformation_gradient(u, r.centre_grad);
+    let j0w = det(&f0w);
+    let j0 = R::narrow(j0w);
     let mut out = ElementOut::zero();
     out.fault_where(
         !j0.gt(R::zero()),
@@ -70,7 +75,7 @@ pub fn compute_forces<R: Real, L: Law>(
         j0,
     );
     // F0^-T = cof(F0) / J0.
-    let f0it = scale(&cofactor(&f0), one / j0);
+    let f0it = narrow3::<R>(&scale(&cofactor(&f0w), one_w / j0w));
     let rho0 = law.density();
     let vol = j0 * r.vol0;
     let l = vol / max_face_area(x);
@@ -86,25 +91,28 @@ pub fn compute_forces<R: Real, L: Law>(
     for gp in 0..8 {
         let g = &r.gp_grad[gp];
         let w = r.gp_weight[gp];
-        let f = deformation_gradient(u, g);
-        let j = det(&f);
+        let fw = wide_deformation_gradient(u, g);
+        let jw = det(&fw);
+        let j = R::narrow(jw);
         out.fault_where(
             !j.gt(R::splat(MIN_GAUSS_VOLUME_RATIO)),
             R::splat(FAULT_DISTORTED),
             j,
         );
         let h = &mut history[gp * hl..(gp + 1) * hl];
-        let fit = scale(&cofactor(&f), one / j);
+        let fit = narrow3::<R>(&scale(&cofactor(&fw), one_w / jw));
         if fbar {
-            let rr = (j0 / j).cbrt();
-            let fb = scale(&f, rr);
-            let resp = law.stress(&fb, input.dt, h);
-            out.fault_where(resp.fault.ne(R::zero()), resp.fault, resp.fault_value);
-            cmax = cmax.max(resp.wave_speed);
-            out.law_dissipation += resp.dissipation * w;
-            out.failed = out.failed | resp.failed;
-            let pb = mul(&fb, &resp.pk2);
-            let pf = ddot(&pb, &f) * (1.0 / 3.0);
+            let rrw = (j0w / jw).cbrt();
+            let fbw = scale(&fw, rrw);
+            let resp = law.stress(&fbw, input.dt, h);
+            let (fault, fault_value) = (R::narrow(resp.fault), R::narrow(resp.fault_value));
+            out.fault_where(fault.ne(R::zero()), fault, fault_value);
+            cmax = cmax.max(R::narrow(resp.wave_speed));
+            out.law_dissipation += R::narrow(resp.dissipation) * w;
+            out.failed = out.failed | R::narrow_mask(resp.failed);
+            let pbw = mul(&fbw, &resp.pk2);
+            let pf = R::narrow(ddot(&pbw, &fw) * (1.0 / 3.0));
+            let (pb, fb, rr) = (narrow3::<R>(&pbw), narrow3::<R>(&fbw), R::narrow(rrw));
             let wr = w * rr;
             add_nodal_forces(fe, &pb, g, wr);
             add_nodal_forces(fe, &scale(&f0it, pf), r.centre_grad, wr);
@@ -120,12 +128,14 @@ pub fn compute_forces<R: Real, L: Law>(
                 vol_acc += w * j0;
             }
         } else {
-            let resp = law.stress(&f, input.dt, h);
-            out.fault_where(resp.fault.ne(R::zero()), resp.fault, resp.fault_value);
-            cmax = cmax.max(resp.wave_speed);
-            out.law_dissipation += resp.dissipation * w;
-            out.failed = out.failed | resp.failed;
-            let p = mul(&f, &resp.pk2);
+            let resp = law.stress(&fw, input.dt, h);
+            let (fault, fault_value) = (R::narrow(resp.fault), R::narrow(resp.fault_value));
+            out.fault_where(fault.ne(R::zero()), fault, fault_value);
+            cmax = cmax.max(R::narrow(resp.wave_speed));
+            out.law_dissipation += R::narrow(resp.dissipation) * w;
+            out.failed = out.failed | R::narrow_mask(resp.failed);
+            let p = narrow3::<R>(&mul(&fw, &resp.pk2));
+            let f = narrow3::<R>(&fw);
             add_nodal_forces(fe, &p, g, w);
             if input.want_stress {
                 let t = mul_bt(&p, &f);

@@ -19,6 +19,7 @@
 pub mod full;
 pub mod one_point;
 pub mod physical;
+pub mod precision;
 
 use material::real::{Mask, Real};
 use material::tensor::M3;
@@ -154,6 +155,8 @@ pub struct StepInput {
     pub bulk: Option<BulkViscosity>,
     /// Also return the Cauchy stress (output step).
     pub want_stress: bool,
+    /// The kernels' number type.
+    pub precision: precision::Precision,
 }
 
 /// What one element (or one batch of elements, one per lane) returns besides its nodal forces.
@@ -249,6 +252,27 @@ pub fn deformation_gradient<R: Real>(u: &Nodal<R>, g: &Nodal<R>) -> M3<R> {
         f[i][i] += R::splat(1.0);
     }
     f
+}
+
+/// F = I + sum_a u_a (x) grad N_a in the law's number type ([`Real::Wide`]): the displacement
+/// gradient is summed in `R` and widened before the identity is added, so single-precision
+/// kernels hand the law an `F` whose `J - 1` is accurate relative to the strain (see
+/// [`material::real_f32`]). For `f64` kernels this is [`deformation_gradient`], operation for
+/// operation.
+#[inline(always)]
+pub fn wide_deformation_gradient<R: Real>(u: &Nodal<R>, g: &Nodal<R>) -> M3<R::Wide> {
+    let h = gradient_rate(u, g);
+    let mut f: M3<R::Wide> = material::arr![3, |i| material::arr![3, |j| h[i][j].widen()]];
+    for i in 0..3 {
+        f[i][i] += R::Wide::splat(1.0);
+    }
+    f
+}
+
+/// A matrix of the law's number type in the kernel's ([`Real::narrow`]).
+#[inline(always)]
+pub fn narrow3<R: Real>(m: &M3<R::Wide>) -> M3<R> {
+    material::arr![3, |i| material::arr![3, |j| R::narrow(m[i][j])]]
 }
 
 /// Rate of F: sum_a v_a (x) grad N_a.

@@ -5,6 +5,7 @@ use super::contact_spec::HandScene;
 use super::def::{DtMin, HourglassGuard, OutputPlan, PartDef, Scene, SceneDef, Setup};
 use super::spec::*;
 use crate::bc::{Constraint, Kinematic, NodalLoad};
+use crate::element::precision::Precision;
 use crate::element::{BulkViscosity, Formulation, Hourglass, HourglassForm, HourglassModulus};
 use crate::generate::{box_mesh, BoxSpec};
 use crate::mesh::Mesh;
@@ -305,6 +306,10 @@ pub fn resolve_scene(
             &format!("must lie in (0, 1], got {dt_factor}"),
         ));
     }
+    let precision = match &spec.run.precision {
+        None => Precision::F64,
+        Some(p) => Precision::parse(p).map_err(|m| e("run.precision", Some("precision"), &m))?,
+    };
     let mut notes = Vec::new();
     let (mut mesh, mut phantom) = read_mesh(&spec.mesh, path, src, prebuilt, &mut notes)?;
     for (i, h) in spec.hands.iter_mut().enumerate() {
@@ -740,6 +745,7 @@ pub fn resolve_scene(
         loads,
         initial_velocity,
         dt_factor,
+        precision,
         dt_max: spec.run.dt_max.map(|t| t.0),
         dt_min: spec.run.dt_min.map(|t| DtMin::Time(t.0)),
         max_steps: match spec.run.max_steps.map(|x| x.0) {

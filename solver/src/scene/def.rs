@@ -12,6 +12,7 @@
 
 use super::contact_def::ContactDef;
 use crate::bc::{Constraint, NodalLoad};
+use crate::element::precision::Precision;
 use crate::element::{BulkViscosity, Formulation};
 use crate::mesh::Mesh;
 use crate::model::{MassScaling, Model, Part};
@@ -68,6 +69,8 @@ pub struct Setup {
     pub initial_velocity: Vec<(Vec<u32>, [f64; 3])>,
     /// Time-step safety factor.
     pub dt_factor: f64,
+    /// The element kernels' number type.
+    pub precision: Precision,
     /// Largest step (s).
     pub dt_max: Option<f64>,
     /// Smallest step before the run stops (default: 1e-6 of the initial step).
@@ -230,6 +233,7 @@ pub fn assemble(def: SceneDef) -> Result<Scene, String> {
     let dt0 = model.scaled_dt.min(model.initial_dt.0);
     let settings = LoopSettings {
         dt_factor: setup.dt_factor,
+        precision: setup.precision,
         bulk: setup.bulk,
         damping: setup.damping,
         gravity: setup.gravity,

@@ -66,6 +66,9 @@ pub struct RunSpec {
     pub end_time: Time,
     /// Time-step safety factor (default 0.9, see [`crate::simulation::DEFAULT_DT_FACTOR`]).
     pub dt_factor: Option<Number>,
+    /// The element kernels' number type: `"f64"` (default) or `"f32"`
+    /// ([`crate::element::precision`]).
+    pub precision: Option<String>,
     /// Largest step.
     pub dt_max: Option<Time>,
     /// Stop if the step falls below this (default: 1e-6 of the initial step).

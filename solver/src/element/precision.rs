@@ -1,0 +1,108 @@
+//! Precision of the element kernels: `f64` (the default) or `f32` ([`Precision`]).
+//!
+//! LS-DYNA's explicit solver is single precision by default; its manual advises double precision
+//! for runs beyond about 200k cycles (a palpation takes 15-35k). palpa's `f32` kernels are the
+//! cautious variant described in [`material::real_f32`]: nodal coordinates, displacements and
+//! velocities, the nodal force sums, the laws and their history stay in `f64`; the element
+//! kinematics, hourglass forces, nodal forces and critical step run in eight `f32` lanes, with
+//! the reference data (gradients, hourglass vectors, element frames, Gauss weights) stored in
+//! `f32` ([`NarrowRef`], half the bytes).
+//!
+//! Before a batch is narrowed, each element's nodal coordinates, displacements and velocities are
+//! taken relative to its first node (in `f64`). Every quantity the kernels form from them is
+//! invariant under that shift: gradients (sum_a grad N_a = 0), hourglass modes (sum_a gamma_a =
+//! 0), face areas (differences). Without it, an element carried 10 mm by the press would lose
+//! `f32` digits of its 0.1 mm of relative motion to the 10 mm they share.
+
+use super::Nodal;
+use material::real::{F64x8, Real};
+use material::real_f32::F32x8;
+
+/// The number type of the element kernels.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Precision {
+    /// Double precision throughout (the default).
+    #[default]
+    F64,
+    /// Single-precision kernels, with the laws and nodal state in double precision.
+    F32,
+}
+
+impl Precision {
+    /// `"f64"` or `"f32"`, as scenes and the command line spell it.
+    pub fn label(&self) -> &'static str {
+        match self {
+            Precision::F64 => "f64",
+            Precision::F32 => "f32",
+        }
+    }
+
+    /// From `"f64"` or `"f32"`; the error names the accepted values.
+    pub fn parse(s: &str) -> Result<Precision, String> {
+        match s {
+            "f64" | "double" => Ok(Precision::F64),
+            "f32" | "single" => Ok(Precision::F32),
+            _ => Err(format!(
+                "unknown precision {s:?}: expected \"f64\" (double) or \"f32\" (single)"
+            )),
+        }
+    }
+}
+
+/// A group's reference data in `f32` lanes, built from the `f64` data the first time an `f32`
+/// run evaluates the group. Fields as in the solver's `Group`; empty where that one is.
+#[derive(Clone, Debug, Default)]
+pub struct NarrowRef {
+    /// Mean gradients, per batch.
+    pub grad: Vec<Nodal<F32x8>>,
+    /// Hourglass vectors, per batch.
+    pub gamma: Vec<[[F32x8; 8]; 4]>,
+    /// Element frames of the physical hourglass form, per batch.
+    pub hg_frame: Vec<[[F32x8; 3]; 3]>,
+    /// Inverse half-lengths of the physical form, per batch.
+    pub hg_inv_len: Vec<[F32x8; 3]>,
+    /// Gauss-point gradients, per batch.
+    pub gp_grad: Vec<[Nodal<F32x8>; 8]>,
+    /// Gauss-point weights, per batch.
+    pub gp_weight: Vec<[F32x8; 8]>,
+}
+
+/// Every lane of an array of lane vectors, rounded to `f32`.
+fn narrow_all<const N: usize, const M: usize>(x: &[[F64x8; N]; M]) -> [[F32x8; N]; M] {
+    x.map(|row| row.map(F32x8::narrow))
+}
+
+impl NarrowRef {
+    /// The `f32` copy of a group's reference data.
+    pub fn new(
+        grad: &[Nodal<F64x8>],
+        gamma: &[[[F64x8; 8]; 4]],
+        hg_frame: &[[[F64x8; 3]; 3]],
+        hg_inv_len: &[[F64x8; 3]],
+        gp_grad: &[[Nodal<F64x8>; 8]],
+        gp_weight: &[[F64x8; 8]],
+    ) -> NarrowRef {
+        NarrowRef {
+            grad: grad.iter().map(narrow_all).collect(),
+            gamma: gamma.iter().map(narrow_all).collect(),
+            hg_frame: hg_frame.iter().map(narrow_all).collect(),
+            hg_inv_len: hg_inv_len.iter().map(|x| x.map(F32x8::narrow)).collect(),
+            gp_grad: gp_grad.iter().map(|g| g.map(|n| narrow_all(&n))).collect(),
+            gp_weight: gp_weight.iter().map(|x| x.map(F32x8::narrow)).collect(),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn precision_parses_its_labels_and_refuses_others() {
+        for p in [Precision::F64, Precision::F32] {
+            assert_eq!(Precision::parse(p.label()), Ok(p));
+        }
+        let e = Precision::parse("f16").unwrap_err();
+        assert!(e.contains("f16") && e.contains("\"f32\""), "{e}");
+    }
+}
