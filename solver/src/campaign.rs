@@ -52,7 +52,8 @@
 //! dt_factor = 0.9
 //! mass_scaling = "initial"         # selective mass scaling: initial (default) | "2 x initial" | "4 us" | "off"
 //! # mass_scaling_limit = 0.05
-//! # fidelity = "fast"             # 1pt-physical elements and K/G <= 5000 (docs/palpate.md)
+//! # fidelity = "fast"             # 1pt-physical elements, K/G <= 5000, f32 kernels (docs/palpate.md)
+//! # precision = "f32"              # element kernels: f64 (default) | f32
 //! # max_bulk_ratio = 5000           # or the K/G cap alone
 //! vtk = false                      # VTK frames of every run (off: only the probe files)
 //! ```
@@ -246,8 +247,11 @@ pub struct SolverSpec {
     /// Write VTK frames of every run (default false).
     pub vtk: Option<bool>,
     /// Preset of the accuracy knobs: `standard` (default) or `fast` (1pt-physical elements,
-    /// K/G capped at 5000; not with `element`, `element_by_part` or `max_bulk_ratio`).
+    /// K/G capped at 5000, f32 kernels; not with `element`, `element_by_part` or
+    /// `max_bulk_ratio`).
     pub fidelity: Option<String>,
+    /// Element-kernel precision, `"f64"` or `"f32"` (default: the preset's).
+    pub precision: Option<String>,
     /// The incompressibility knob: cap every part's bulk modulus at this multiple of its
     /// shear modulus (as `palpate --max-bulk-ratio`).
     pub max_bulk_ratio: Option<Number>,
@@ -523,6 +527,10 @@ impl CampaignSpec {
             }
             fid.apply(&mut base);
             base.fidelity = fid;
+        }
+        if let Some(p) = &sv.precision {
+            base.precision = crate::element::precision::Precision::parse(p)
+                .map_err(|e| format!("solver.precision: {e}"))?;
         }
         if let Some(f) = sv.dt_factor {
             base.dt_factor = f.0;
@@ -1101,6 +1109,17 @@ mod tests {
         assert_eq!(c.base.max_bulk_ratio, Some(5000.0));
         let scene = c.base.scene_toml();
         assert!(scene.contains("max_bulk_ratio = 5000.0"), "{scene}");
+        assert!(scene.contains("precision = \"f32\""), "{scene}");
+        let spec: CampaignSpec =
+            toml::from_str("[solver]\nfidelity = \"fast\"\nprecision = \"f64\"\n").unwrap();
+        assert!(spec
+            .resolve()
+            .unwrap()
+            .base
+            .scene_toml()
+            .contains("precision = \"f64\""));
+        let spec: CampaignSpec = toml::from_str("[solver]\nprecision = \"f16\"\n").unwrap();
+        assert!(spec.resolve().unwrap_err().contains("solver.precision"));
         for extra in ["element = \"full_fbar\"", "max_bulk_ratio = 100"] {
             let spec: CampaignSpec =
                 toml::from_str(&format!("[solver]\nfidelity = \"fast\"\n{extra}\n")).unwrap();

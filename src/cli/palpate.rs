@@ -75,14 +75,15 @@ pub struct PalpateArgs {
     #[arg(long)]
     pub max_bulk_ratio: Option<f64>,
     /// Preset of the accuracy knobs: `standard` (the options as given) or `fast`
-    /// (1pt-physical elements and K/G capped at 5000: about a third of the steps; its measured
+    /// (1pt-physical elements, K/G capped at 5000 and f32 kernels: about a third of the steps; its measured
     /// error against F-bar elements is printed with the summary and in docs/palpate.md).
     #[arg(long, default_value = "standard")]
     pub fidelity: String,
-    /// Number type of the element kernels: f64 (default) or f32 (single-precision kernels; the
-    /// laws, history and nodal state stay f64; measured cost in docs/performance.md).
-    #[arg(long, default_value = "f64")]
-    pub precision: String,
+    /// Number type of the element kernels: f64 or f32 (single-precision kernels; the laws,
+    /// history and nodal state stay f64; measured cost in docs/performance.md). Default: the
+    /// preset's (f64 for standard, f32 for fast).
+    #[arg(long)]
+    pub precision: Option<String>,
     /// Skip the VTK frames.
     #[arg(long)]
     pub no_vtk: bool,
@@ -149,8 +150,10 @@ impl PalpateArgs {
         }
         fidelity.apply(&mut s);
         s.fidelity = fidelity;
-        s.precision = solver::element::precision::Precision::parse(&self.precision)
-            .map_err(|e| format!("--precision: {e}"))?;
+        if let Some(p) = &self.precision {
+            s.precision = solver::element::precision::Precision::parse(p)
+                .map_err(|e| format!("--precision: {e}"))?;
+        }
         s.vtk = !self.no_vtk;
         s.title = match &s.place {
             Place::Named(n) => format!("palpation at {n}"),

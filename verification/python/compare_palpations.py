@@ -56,8 +56,8 @@ def main(ref, runs):
             [r[k] for r in s0 for k in range(1, len(c0))],
             [r[k] for r in s1 for k in range(1, len(c0))],
         )
-        print(f"{d}: hand force {', '.join(force)}; ROI Fit {pooled:.3f} (per sample "
-              + " ".join(f"{x:.3f}" for x in per) + ")")
+        print(f"{d}: hand force {', '.join(force)}; ROI Fit {pooled:.4f} (per sample "
+              + " ".join(f"{x:.4f}" for x in per) + ")")
 
 
 if __name__ == "__main__":
