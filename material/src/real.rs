@@ -300,78 +300,140 @@ impl F64x8 {
     }
 }
 
-impl BitAnd for M8 {
-    type Output = M8;
-    #[inline(always)]
-    fn bitand(self, o: M8) -> M8 {
-        M8(self.0 & o.0)
-    }
-}
-impl BitOr for M8 {
-    type Output = M8;
-    #[inline(always)]
-    fn bitor(self, o: M8) -> M8 {
-        M8(self.0 | o.0)
-    }
-}
-impl Not for M8 {
-    type Output = M8;
-    #[inline(always)]
-    fn not(self) -> M8 {
-        M8(!self.0)
-    }
-}
-impl Mask for M8 {
-    #[inline(always)]
-    fn splat(b: bool) -> Self {
-        M8(f64x8::splat(if b { f64::from_bits(u64::MAX) } else { 0.0 }))
-    }
-    #[inline(always)]
-    fn any(self) -> bool {
-        self.0.any()
-    }
-    #[inline(always)]
-    fn lane(self, i: usize) -> bool {
-        self.0.to_bitmask() >> i & 1 == 1
-    }
-}
-
-macro_rules! binop {
-    ($tr:ident, $f:ident, $atr:ident, $af:ident, $op:tt) => {
-        impl $tr for F64x8 {
-            type Output = F64x8;
+/// The operators shared by the lane types ([`F64x8`], [`crate::real_f32::F32x8`]): `$t` wraps
+/// the `wide` vector `$w` of `$s` lanes, `$m` its mask. Arithmetic with a plain `f64` rounds it
+/// to `$s` first.
+macro_rules! lane_operators {
+    ($t:ident, $m:ident, $w:ident, $s:ident) => {
+        impl BitAnd for $m {
+            type Output = $m;
             #[inline(always)]
-            fn $f(self, o: F64x8) -> F64x8 {
-                F64x8(self.0 $op o.0)
+            fn bitand(self, o: $m) -> $m {
+                $m(self.0 & o.0)
             }
         }
-        impl $tr<f64> for F64x8 {
-            type Output = F64x8;
+        impl BitOr for $m {
+            type Output = $m;
             #[inline(always)]
-            fn $f(self, o: f64) -> F64x8 {
-                F64x8(self.0 $op f64x8::splat(o))
+            fn bitor(self, o: $m) -> $m {
+                $m(self.0 | o.0)
             }
         }
-        impl $atr for F64x8 {
+        impl Not for $m {
+            type Output = $m;
             #[inline(always)]
-            fn $af(&mut self, o: F64x8) {
+            fn not(self) -> $m {
+                $m(!self.0)
+            }
+        }
+        impl Mask for $m {
+            #[inline(always)]
+            fn splat(b: bool) -> Self {
+                $m($w::splat(if b { $s::from_bits(!0) } else { 0.0 }))
+            }
+            #[inline(always)]
+            fn any(self) -> bool {
+                self.0.any()
+            }
+            #[inline(always)]
+            fn lane(self, i: usize) -> bool {
+                self.0.to_bitmask() >> i & 1 == 1
+            }
+        }
+        lane_operators!(@bin $t, $w, $s, Add, add, AddAssign, add_assign, +);
+        lane_operators!(@bin $t, $w, $s, Sub, sub, SubAssign, sub_assign, -);
+        lane_operators!(@bin $t, $w, $s, Mul, mul, MulAssign, mul_assign, *);
+        lane_operators!(@bin $t, $w, $s, Div, div, DivAssign, div_assign, /);
+        impl Neg for $t {
+            type Output = $t;
+            #[inline(always)]
+            fn neg(self) -> $t {
+                $t(-self.0)
+            }
+        }
+    };
+    (@bin $t:ident, $w:ident, $s:ident, $tr:ident, $f:ident, $atr:ident, $af:ident, $op:tt) => {
+        impl $tr for $t {
+            type Output = $t;
+            #[inline(always)]
+            fn $f(self, o: $t) -> $t {
+                $t(self.0 $op o.0)
+            }
+        }
+        impl $tr<f64> for $t {
+            type Output = $t;
+            #[inline(always)]
+            #[allow(clippy::unnecessary_cast)]
+            fn $f(self, o: f64) -> $t {
+                $t(self.0 $op $w::splat(o as $s))
+            }
+        }
+        impl $atr for $t {
+            #[inline(always)]
+            fn $af(&mut self, o: $t) {
                 *self = *self $op o;
             }
         }
     };
 }
-binop!(Add, add, AddAssign, add_assign, +);
-binop!(Sub, sub, SubAssign, sub_assign, -);
-binop!(Mul, mul, MulAssign, mul_assign, *);
-binop!(Div, div, DivAssign, div_assign, /);
+pub(crate) use lane_operators;
 
-impl Neg for F64x8 {
-    type Output = F64x8;
-    #[inline(always)]
-    fn neg(self) -> F64x8 {
-        F64x8(-self.0)
-    }
+/// The [`Real`] methods shared by the lane types, written inside their `impl Real` blocks:
+/// square root, |x|, `max`/`min` with `f64::max`'s NaN rule, comparisons and select.
+macro_rules! lane_real_methods {
+    ($t:ident, $m:ident, $w:ident, $s:ident) => {
+        #[inline(always)]
+        fn sqrt(self) -> Self {
+            $t(self.0.sqrt())
+        }
+        #[inline(always)]
+        fn abs(self) -> Self {
+            $t(self.0.abs())
+        }
+        #[inline(always)]
+        fn max(self, o: Self) -> Self {
+            // As f64::max: the other operand where one is NaN.
+            let m = $t(self.0.max(o.0));
+            Self::select(self.ne(self), o, Self::select(o.ne(o), self, m))
+        }
+        #[inline(always)]
+        fn min(self, o: Self) -> Self {
+            let m = $t(self.0.min(o.0));
+            Self::select(self.ne(self), o, Self::select(o.ne(o), self, m))
+        }
+        #[inline(always)]
+        fn lt(self, o: Self) -> $m {
+            $m(self.0.simd_lt(o.0))
+        }
+        #[inline(always)]
+        fn le(self, o: Self) -> $m {
+            $m(self.0.simd_le(o.0))
+        }
+        #[inline(always)]
+        fn gt(self, o: Self) -> $m {
+            $m(self.0.simd_gt(o.0))
+        }
+        #[inline(always)]
+        fn ge(self, o: Self) -> $m {
+            $m(self.0.simd_ge(o.0))
+        }
+        #[inline(always)]
+        fn ne(self, o: Self) -> $m {
+            $m(self.0.simd_ne(o.0))
+        }
+        #[inline(always)]
+        fn is_finite(self) -> $m {
+            $m(self.0.abs().simd_lt($w::splat($s::INFINITY)))
+        }
+        #[inline(always)]
+        fn select(m: $m, a: Self, b: Self) -> Self {
+            $t(m.0.select(a.0, b.0))
+        }
+    };
 }
+pub(crate) use lane_real_methods;
+
+lane_operators!(F64x8, M8, f64x8, f64);
 
 impl Real for F64x8 {
     type Mask = M8;
@@ -410,10 +472,6 @@ impl Real for F64x8 {
         out[..LANES].copy_from_slice(self.0.as_array());
     }
     #[inline(always)]
-    fn sqrt(self) -> Self {
-        F64x8(self.0.sqrt())
-    }
-    #[inline(always)]
     fn cbrt(self) -> Self {
         cbrt_lanes(self)
     }
@@ -437,49 +495,7 @@ impl Real for F64x8 {
     fn ln_1p(self) -> Self {
         ln_1p_lanes(self)
     }
-    #[inline(always)]
-    fn abs(self) -> Self {
-        F64x8(self.0.abs())
-    }
-    #[inline(always)]
-    fn max(self, o: Self) -> Self {
-        // As f64::max: the other operand where one is NaN.
-        let m = F64x8(self.0.max(o.0));
-        Self::select(self.ne(self), o, Self::select(o.ne(o), self, m))
-    }
-    #[inline(always)]
-    fn min(self, o: Self) -> Self {
-        let m = F64x8(self.0.min(o.0));
-        Self::select(self.ne(self), o, Self::select(o.ne(o), self, m))
-    }
-    #[inline(always)]
-    fn lt(self, o: Self) -> M8 {
-        M8(self.0.simd_lt(o.0))
-    }
-    #[inline(always)]
-    fn le(self, o: Self) -> M8 {
-        M8(self.0.simd_le(o.0))
-    }
-    #[inline(always)]
-    fn gt(self, o: Self) -> M8 {
-        M8(self.0.simd_gt(o.0))
-    }
-    #[inline(always)]
-    fn ge(self, o: Self) -> M8 {
-        M8(self.0.simd_ge(o.0))
-    }
-    #[inline(always)]
-    fn ne(self, o: Self) -> M8 {
-        M8(self.0.simd_ne(o.0))
-    }
-    #[inline(always)]
-    fn is_finite(self) -> M8 {
-        M8(self.0.abs().simd_lt(f64x8::splat(f64::INFINITY)))
-    }
-    #[inline(always)]
-    fn select(m: M8, a: Self, b: Self) -> Self {
-        F64x8(m.0.select(a.0, b.0))
-    }
+    lane_real_methods!(F64x8, M8, f64x8, f64);
 }
 
 impl F64x8 {

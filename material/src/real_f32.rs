@@ -15,7 +15,7 @@
 //! History stays in `f64` (it belongs to the law). Conversions round to nearest, so the results
 //! do not depend on the instruction set. Transcendentals are those of [`F64x8`], narrowed.
 
-use crate::real::{F64x8, Mask, Real, LANES, M8};
+use crate::real::{lane_operators, lane_real_methods, F64x8, Mask, Real, LANES, M8};
 use std::ops::{
     Add, AddAssign, BitAnd, BitOr, Div, DivAssign, Mul, MulAssign, Neg, Not, Sub, SubAssign,
 };
@@ -44,78 +44,7 @@ impl F32x8 {
     }
 }
 
-impl BitAnd for M8f {
-    type Output = M8f;
-    #[inline(always)]
-    fn bitand(self, o: M8f) -> M8f {
-        M8f(self.0 & o.0)
-    }
-}
-impl BitOr for M8f {
-    type Output = M8f;
-    #[inline(always)]
-    fn bitor(self, o: M8f) -> M8f {
-        M8f(self.0 | o.0)
-    }
-}
-impl Not for M8f {
-    type Output = M8f;
-    #[inline(always)]
-    fn not(self) -> M8f {
-        M8f(!self.0)
-    }
-}
-impl Mask for M8f {
-    #[inline(always)]
-    fn splat(b: bool) -> Self {
-        M8f(f32x8::splat(if b { f32::from_bits(u32::MAX) } else { 0.0 }))
-    }
-    #[inline(always)]
-    fn any(self) -> bool {
-        self.0.any()
-    }
-    #[inline(always)]
-    fn lane(self, i: usize) -> bool {
-        self.0.to_bitmask() >> i & 1 == 1
-    }
-}
-
-macro_rules! binop32 {
-    ($tr:ident, $f:ident, $atr:ident, $af:ident, $op:tt) => {
-        impl $tr for F32x8 {
-            type Output = F32x8;
-            #[inline(always)]
-            fn $f(self, o: F32x8) -> F32x8 {
-                F32x8(self.0 $op o.0)
-            }
-        }
-        impl $tr<f64> for F32x8 {
-            type Output = F32x8;
-            #[inline(always)]
-            fn $f(self, o: f64) -> F32x8 {
-                F32x8(self.0 $op f32x8::splat(o as f32))
-            }
-        }
-        impl $atr for F32x8 {
-            #[inline(always)]
-            fn $af(&mut self, o: F32x8) {
-                *self = *self $op o;
-            }
-        }
-    };
-}
-binop32!(Add, add, AddAssign, add_assign, +);
-binop32!(Sub, sub, SubAssign, sub_assign, -);
-binop32!(Mul, mul, MulAssign, mul_assign, *);
-binop32!(Div, div, DivAssign, div_assign, /);
-
-impl Neg for F32x8 {
-    type Output = F32x8;
-    #[inline(always)]
-    fn neg(self) -> F32x8 {
-        F32x8(-self.0)
-    }
-}
+lane_operators!(F32x8, M8f, f32x8, f32);
 
 /// A function of [`F64x8`] applied to [`F32x8`] lanes: widened, evaluated, narrowed.
 #[inline(always)]
@@ -172,10 +101,6 @@ impl Real for F32x8 {
         }
     }
     #[inline(always)]
-    fn sqrt(self) -> Self {
-        F32x8(self.0.sqrt())
-    }
-    #[inline(always)]
     fn cbrt(self) -> Self {
         through_f64(self, F64x8::cbrt)
     }
@@ -195,49 +120,7 @@ impl Real for F32x8 {
     fn ln_1p(self) -> Self {
         through_f64(self, F64x8::ln_1p)
     }
-    #[inline(always)]
-    fn abs(self) -> Self {
-        F32x8(self.0.abs())
-    }
-    #[inline(always)]
-    fn max(self, o: Self) -> Self {
-        // As f64::max: the other operand where one is NaN.
-        let m = F32x8(self.0.max(o.0));
-        Self::select(self.ne(self), o, Self::select(o.ne(o), self, m))
-    }
-    #[inline(always)]
-    fn min(self, o: Self) -> Self {
-        let m = F32x8(self.0.min(o.0));
-        Self::select(self.ne(self), o, Self::select(o.ne(o), self, m))
-    }
-    #[inline(always)]
-    fn lt(self, o: Self) -> M8f {
-        M8f(self.0.simd_lt(o.0))
-    }
-    #[inline(always)]
-    fn le(self, o: Self) -> M8f {
-        M8f(self.0.simd_le(o.0))
-    }
-    #[inline(always)]
-    fn gt(self, o: Self) -> M8f {
-        M8f(self.0.simd_gt(o.0))
-    }
-    #[inline(always)]
-    fn ge(self, o: Self) -> M8f {
-        M8f(self.0.simd_ge(o.0))
-    }
-    #[inline(always)]
-    fn ne(self, o: Self) -> M8f {
-        M8f(self.0.simd_ne(o.0))
-    }
-    #[inline(always)]
-    fn is_finite(self) -> M8f {
-        M8f(self.0.abs().simd_lt(f32x8::splat(f32::INFINITY)))
-    }
-    #[inline(always)]
-    fn select(m: M8f, a: Self, b: Self) -> Self {
-        F32x8(m.0.select(a.0, b.0))
-    }
+    lane_real_methods!(F32x8, M8f, f32x8, f32);
 }
 
 #[cfg(test)]
