@@ -112,6 +112,9 @@ pub struct RunNote {
     pub hourglass_check_after: Option<f64>,
     /// Smallest step (s).
     pub dt_min: Option<f64>,
+    /// The element kernels' number type (`"f32"`; absent: `f64`). LS-DYNA chooses its
+    /// precision by executable, so palpa keeps it in the note.
+    pub precision: Option<String>,
 }
 
 /// Dynamic relaxation (the scene's `[relaxation]`).

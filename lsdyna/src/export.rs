@@ -38,6 +38,7 @@ use contact::{Curve, MotionSpec, PenaltyKind, ShapeSpec};
 use material::quantity::Dim;
 use material::{Material, MaterialSpec};
 use solver::bc::Kinematic;
+use solver::element::precision::Precision;
 use solver::element::{Formulation, HourglassForm, HourglassModulus};
 use solver::model::StepTarget;
 use solver::scene::def::DtMin;
@@ -574,6 +575,13 @@ pub fn export(scene: &Scene, opts: &ExportOptions) -> Result<Exported, String> {
     }
     if let Some(DtMin::Time(t)) = setup.dt_min {
         run_note.push(format!("dt_min = {}", tn(t)));
+    }
+    if setup.precision != Precision::F64 {
+        run_note.push(format!("precision = {:?}", setup.precision.label()));
+        notes.push(format!(
+            "run.precision = \"{}\" has no LS-DYNA keyword (LS-DYNA's precision is its executable's): a $palpa comment",
+            setup.precision.label()
+        ));
     }
     if !run_note.is_empty() {
         w.palpa("run", &format!("{{ {} }}", run_note.join(", ")));

@@ -42,6 +42,7 @@ use material::spec::{FoamSpec, IsotropicSpec, OgdenSpec, PlasticitySpec, PronySp
 use material::{Material, MaterialSpec};
 use serde::Deserialize;
 use solver::bc::{Constraint, Kinematic, NodalLoad};
+use solver::element::precision::Precision;
 use solver::element::{BulkViscosity, Formulation, Hourglass, HourglassForm, HourglassModulus};
 use solver::mesh::Mesh;
 use solver::model::{MassScaling, StepTarget};
@@ -985,6 +986,16 @@ fn build(cx: &mut Ctx, path: &Path) -> Result<SceneDef, Vec<String>> {
     if let Some(t) = run_note.dt_min {
         dt_min = Some(DtMin::Time(t));
     }
+    let precision = match run_note.precision.as_deref() {
+        None => Precision::F64,
+        Some(p) => match Precision::parse(p) {
+            Ok(p) => p,
+            Err(m) => {
+                errors.push(format!("{hdr_at}: $palpa run: precision: {m}"));
+                Precision::F64
+            }
+        },
+    };
     let hourglass_guard = run_note.max_hourglass_ratio.map(|ratio| HourglassGuard {
         ratio,
         after: run_note.hourglass_check_after,
@@ -1162,8 +1173,8 @@ fn build(cx: &mut Ctx, path: &Path) -> Result<SceneDef, Vec<String>> {
             initial_velocity,
             dt_factor,
             // LS-DYNA chooses its precision by executable, not by keyword: a deck runs in
-            // f64 unless the command line asks otherwise.
-            precision: solver::element::precision::Precision::F64,
+            // f64 unless palpa's own `$palpa run` note says otherwise.
+            precision,
             dt_max,
             dt_min,
             max_steps: None,

@@ -79,6 +79,7 @@ fn same(a: &Scene, b: &Scene) {
     );
     assert_eq!(format!("{:?}", sa.loads), format!("{:?}", sb.loads));
     assert_eq!(sa.dt_factor, sb.dt_factor);
+    assert_eq!(sa.precision, sb.precision);
     assert_eq!(format!("{:?}", sa.bulk), format!("{:?}", sb.bulk));
     assert_eq!(
         format!("{:?}", sa.mass_scaling),

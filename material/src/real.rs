@@ -73,8 +73,6 @@ pub trait Real:
     /// The number type laws are evaluated in for a kernel over `Self`: `Self` itself, except for
     /// the single-precision lanes ([`crate::real_f32::F32x8`]), whose laws run in [`F64x8`].
     type Wide: Real;
-    /// True where `Self` holds fewer digits than [`Real::Wide`] (single precision).
-    const NARROW: bool = false;
     /// To the law's number type (exact).
     fn widen(self) -> Self::Wide;
     /// From the law's number type (rounded to nearest where `Self` is narrower).

@@ -56,7 +56,6 @@ impl Real for F32x8 {
     type Mask = M8f;
     const LANES: usize = LANES;
     type Wide = F64x8;
-    const NARROW: bool = true;
     #[inline(always)]
     fn widen(self) -> F64x8 {
         let a = self.0.to_array();

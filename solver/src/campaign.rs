@@ -521,9 +521,10 @@ impl CampaignSpec {
             if fid == crate::palpation::Fidelity::Fast
                 && (sv.element.is_some()
                     || sv.element_by_part.is_some()
-                    || sv.max_bulk_ratio.is_some())
+                    || sv.max_bulk_ratio.is_some()
+                    || sv.precision.is_some())
             {
-                return Err("solver.fidelity = \"fast\" sets the element and max_bulk_ratio: give the preset or those keys".into());
+                return Err("solver.fidelity = \"fast\" sets the element, max_bulk_ratio and precision: give the preset or those keys".into());
             }
             fid.apply(&mut base);
             base.fidelity = fid;
@@ -822,6 +823,10 @@ impl Campaign {
         if let Some(r) = b.max_bulk_ratio {
             plan["settings"]["max_bulk_ratio"] = json!(r);
         }
+        // So does the kernels' precision (only when not the default, as above).
+        if b.precision != crate::element::precision::Precision::F64 {
+            plan["settings"]["precision"] = json!(b.precision.label());
+        }
         plan
     }
 }
@@ -1110,17 +1115,16 @@ mod tests {
         let scene = c.base.scene_toml();
         assert!(scene.contains("max_bulk_ratio = 5000.0"), "{scene}");
         assert!(scene.contains("precision = \"f32\""), "{scene}");
-        let spec: CampaignSpec =
-            toml::from_str("[solver]\nfidelity = \"fast\"\nprecision = \"f64\"\n").unwrap();
-        assert!(spec
-            .resolve()
-            .unwrap()
-            .base
-            .scene_toml()
-            .contains("precision = \"f64\""));
+        let spec: CampaignSpec = toml::from_str("[solver]\nprecision = \"f32\"\n").unwrap();
+        let c = spec.resolve().unwrap();
+        assert!(c.base.scene_toml().contains("precision = \"f32\""));
         let spec: CampaignSpec = toml::from_str("[solver]\nprecision = \"f16\"\n").unwrap();
         assert!(spec.resolve().unwrap_err().contains("solver.precision"));
-        for extra in ["element = \"full_fbar\"", "max_bulk_ratio = 100"] {
+        for extra in [
+            "element = \"full_fbar\"",
+            "max_bulk_ratio = 100",
+            "precision = \"f64\"",
+        ] {
             let spec: CampaignSpec =
                 toml::from_str(&format!("[solver]\nfidelity = \"fast\"\n{extra}\n")).unwrap();
             let e = spec.resolve().unwrap_err();

@@ -295,6 +295,17 @@ impl Group {
         self.elements.len().div_ceil(LANES)
     }
 
+    /// Bytes of the reference data the `f64` kernels read (gradients, hourglass vectors and
+    /// frames, Gauss-point gradients and weights).
+    pub fn reference_bytes(&self) -> usize {
+        std::mem::size_of_val(self.grad.as_slice())
+            + std::mem::size_of_val(self.gamma.as_slice())
+            + std::mem::size_of_val(self.hg_frame.as_slice())
+            + std::mem::size_of_val(self.hg_inv_len.as_slice())
+            + std::mem::size_of_val(self.gp_grad.as_slice())
+            + std::mem::size_of_val(self.gp_weight.as_slice())
+    }
+
     /// History value `k` of integration point `ip` of group-local element `le`.
     pub fn history_value(&self, le: usize, ip: usize, k: usize, history_len: usize) -> f64 {
         self.history[(le / LANES) * self.history_stride + ip * history_len + k].lane(le % LANES)

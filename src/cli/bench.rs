@@ -148,18 +148,8 @@ fn step_bytes_per_element(m: &solver::model::Model) -> f64 {
     for g in &m.groups {
         // An f32 run reads its reference data from the group's f32 copy.
         let reference = match g.narrow.as_deref() {
-            Some(n) => {
-                std::mem::size_of_val(n.grad.as_slice())
-                    + std::mem::size_of_val(n.gamma.as_slice())
-                    + std::mem::size_of_val(n.gp_grad.as_slice())
-                    + std::mem::size_of_val(n.gp_weight.as_slice())
-            }
-            None => {
-                std::mem::size_of_val(g.grad.as_slice())
-                    + std::mem::size_of_val(g.gamma.as_slice())
-                    + std::mem::size_of_val(g.gp_grad.as_slice())
-                    + std::mem::size_of_val(g.gp_weight.as_slice())
-            }
+            Some(n) => n.bytes(),
+            None => g.reference_bytes(),
         };
         bytes += g.conn.len() * (32 + 8 + 8)
             + reference

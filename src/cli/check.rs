@@ -122,20 +122,30 @@ pub fn check(path: &Path, deck: &DeckArgs, pilot: Pilot) -> Result<(), String> {
         }
     );
     let hist: usize = m.groups.iter().map(|g| g.history.len() * 8).sum();
+    // f32 kernels keep an f32 copy of the reference data beside the f64 one (half its size).
+    let narrow = sim.settings.precision == solver::element::precision::Precision::F32;
     let ref_data: usize = m
         .groups
         .iter()
         .map(|g| {
+            let r = g.reference_bytes();
             g.conn.len() * (8 * 4 + 8)
-                + std::mem::size_of_val(g.grad.as_slice())
-                + std::mem::size_of_val(g.gamma.as_slice())
-                + std::mem::size_of_val(g.gp_grad.as_slice())
-                + std::mem::size_of_val(g.gp_weight.as_slice())
+                + r
+                + if narrow { r / 2 } else { 0 }
                 + g.density_scale.len() * 8
         })
         .sum();
     let nodal = mesh.nodes.len() * 8 * (3 * 7 + 1);
     let bytes = ref_data + hist * 8 + nodal;
+    println!(
+        "  element kernels: {}{}",
+        sim.settings.precision.label(),
+        if narrow {
+            " (laws, history and nodal state in f64)"
+        } else {
+            ""
+        }
+    );
     println!(
         "  memory estimate: {:.1} MiB (history {:.1} MiB)",
         bytes as f64 / 1048576.0,

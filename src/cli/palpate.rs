@@ -142,9 +142,11 @@ impl PalpateArgs {
             .fidelity
             .parse::<Fidelity>()
             .map_err(|e| format!("--fidelity: {e}"))?;
-        if fidelity == Fidelity::Fast && (self.element.is_some() || self.max_bulk_ratio.is_some()) {
+        if fidelity == Fidelity::Fast
+            && (self.element.is_some() || self.max_bulk_ratio.is_some() || self.precision.is_some())
+        {
             return Err(
-                "--fidelity fast sets --element and --max-bulk-ratio: give the preset or the options"
+                "--fidelity fast sets --element, --max-bulk-ratio and --precision: give the preset or the options"
                     .into(),
             );
         }

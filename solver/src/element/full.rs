@@ -15,8 +15,8 @@
 
 use super::{
     add_nodal_forces, all_finite, bulk_pressure, critical_step, gradient_rate, max_face_area,
-    narrow3, sym6, wide_deformation_gradient, ElementOut, Nodal, StepInput, FAULT_DISTORTED,
-    FAULT_FORCE,
+    narrow3, narrow_law_out, sym6, wide_deformation_gradient, ElementOut, Nodal, StepInput,
+    FAULT_DISTORTED, FAULT_FORCE,
 };
 use material::real::Real;
 use material::tensor::{cofactor, ddot, det, mul, mul_bt, scale, M3};
@@ -104,13 +104,11 @@ pub fn compute_forces<R: Real, L: Law>(
         if fbar {
             let rrw = (j0w / jw).cbrt();
             let fbw = scale(&fw, rrw);
-            let resp = law.stress(&fbw, input.dt, h);
-            let (fault, fault_value) = (R::narrow(resp.fault), R::narrow(resp.fault_value));
-            out.fault_where(fault.ne(R::zero()), fault, fault_value);
-            cmax = cmax.max(R::narrow(resp.wave_speed));
-            out.law_dissipation += R::narrow(resp.dissipation) * w;
-            out.failed = out.failed | R::narrow_mask(resp.failed);
-            let pbw = mul(&fbw, &resp.pk2);
+            let resp_w = law.stress(&fbw, input.dt, h);
+            let resp = narrow_law_out::<R>(&resp_w);
+            out.absorb_law(&resp, w);
+            cmax = cmax.max(resp.wave_speed);
+            let pbw = mul(&fbw, &resp_w.pk2);
             let pf = R::narrow(ddot(&pbw, &fw) * (1.0 / 3.0));
             let (pb, fb, rr) = (narrow3::<R>(&pbw), narrow3::<R>(&fbw), R::narrow(rrw));
             let wr = w * rr;
@@ -128,13 +126,11 @@ pub fn compute_forces<R: Real, L: Law>(
                 vol_acc += w * j0;
             }
         } else {
-            let resp = law.stress(&fw, input.dt, h);
-            let (fault, fault_value) = (R::narrow(resp.fault), R::narrow(resp.fault_value));
-            out.fault_where(fault.ne(R::zero()), fault, fault_value);
-            cmax = cmax.max(R::narrow(resp.wave_speed));
-            out.law_dissipation += R::narrow(resp.dissipation) * w;
-            out.failed = out.failed | R::narrow_mask(resp.failed);
-            let p = narrow3::<R>(&mul(&fw, &resp.pk2));
+            let resp_w = law.stress(&fw, input.dt, h);
+            let resp = narrow_law_out::<R>(&resp_w);
+            out.absorb_law(&resp, w);
+            cmax = cmax.max(resp.wave_speed);
+            let p = narrow3::<R>(&mul(&fw, &resp_w.pk2));
             let f = narrow3::<R>(&fw);
             add_nodal_forces(fe, &p, g, w);
             if input.want_stress {

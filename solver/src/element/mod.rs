@@ -21,6 +21,7 @@ pub mod one_point;
 pub mod physical;
 pub mod precision;
 
+use material::law::LawOut;
 use material::real::{Mask, Real};
 use material::tensor::M3;
 use material::LawError;
@@ -201,6 +202,15 @@ impl<R: Real> ElementOut<R> {
         }
     }
 
+    /// Take in one integration point's law answer: its fault (if no earlier one), its
+    /// dissipation times the point's weight `w` (J), its failure.
+    #[inline(always)]
+    pub fn absorb_law(&mut self, resp: &LawOut<R>, w: R) {
+        self.fault_where(resp.fault.ne(R::zero()), resp.fault, resp.fault_value);
+        self.law_dissipation += resp.dissipation * w;
+        self.failed = self.failed | resp.failed;
+    }
+
     /// Record a fault where `m` is set and no earlier fault is.
     #[inline(always)]
     pub fn fault_where(&mut self, m: R::Mask, code: R, value: R) {
@@ -273,6 +283,19 @@ pub fn wide_deformation_gradient<R: Real>(u: &Nodal<R>, g: &Nodal<R>) -> M3<R::W
 #[inline(always)]
 pub fn narrow3<R: Real>(m: &M3<R::Wide>) -> M3<R> {
     material::arr![3, |i| material::arr![3, |j| R::narrow(m[i][j])]]
+}
+
+/// A law's answer in the kernel's number type ([`Real::narrow`]); the identity for `f64` kernels.
+#[inline(always)]
+pub fn narrow_law_out<R: Real>(o: &LawOut<R::Wide>) -> LawOut<R> {
+    LawOut {
+        pk2: narrow3::<R>(&o.pk2),
+        wave_speed: R::narrow(o.wave_speed),
+        dissipation: R::narrow(o.dissipation),
+        failed: R::narrow_mask(o.failed),
+        fault: R::narrow(o.fault),
+        fault_value: R::narrow(o.fault_value),
+    }
 }
 
 /// Rate of F: sum_a v_a (x) grad N_a.

@@ -7,8 +7,8 @@
 use super::physical::{self, PhysicalRef};
 use super::{
     add_nodal_forces, all_finite, bulk_pressure, critical_step, dot8, gradient_rate, max_face_area,
-    narrow3, sym6, wide_deformation_gradient, ElementOut, HourglassForm, Nodal, StepInput,
-    FAULT_FORCE,
+    narrow3, narrow_law_out, sym6, wide_deformation_gradient, ElementOut, HourglassForm, Nodal,
+    StepInput, FAULT_FORCE,
 };
 use material::real::Real;
 use material::tensor::{cofactor, ddot, det, mul, mul_bt, scale, M3};
@@ -48,28 +48,27 @@ pub fn compute_forces<R: Real, L: Law>(
 ) -> ElementOut<R> {
     // F, the law, J and P in the law's number type; the rest in the kernel's.
     let fw = wide_deformation_gradient(u, r.grad);
-    let resp = law.stress(&fw, input.dt, history);
+    let resp_w = law.stress(&fw, input.dt, history);
     let (f, j) = (narrow3::<R>(&fw), R::narrow(det(&fw)));
-    let mut p = narrow3::<R>(&mul(&fw, &resp.pk2));
-    let pk2 = narrow3::<R>(&resp.pk2);
-    let wave_speed = R::narrow(resp.wave_speed);
+    let mut p = narrow3::<R>(&mul(&fw, &resp_w.pk2));
+    let resp = narrow_law_out::<R>(&resp_w);
     let rho0 = law.density();
     let sqrt_scale = density_scale.sqrt();
-    let c = wave_speed / sqrt_scale;
+    let c = resp.wave_speed / sqrt_scale;
     let vol = j * r.vol0;
     let l = vol / max_face_area(x);
     let mut out = ElementOut::zero();
-    out.law_dissipation = R::narrow(resp.dissipation) * r.vol0;
-    out.failed = R::narrow_mask(resp.failed);
-    out.fault = R::narrow(resp.fault);
-    out.fault_value = R::narrow(resp.fault_value);
+    out.law_dissipation = resp.dissipation * r.vol0;
+    out.failed = resp.failed;
+    out.fault = resp.fault;
+    out.fault_value = resp.fault_value;
     let mut qterm = R::zero();
     let mut q = R::zero();
     if let Some(bv) = input.bulk.as_ref() {
         // tr D = Fdot : F^-T = Fdot : cof(F) / J.
         let cof = cofactor(&f);
         let trd = ddot(&gradient_rate(v, r.grad), &cof) / j;
-        let (qq, qt) = bulk_pressure(bv, trd, R::splat(rho0) / j, l, wave_speed);
+        let (qq, qt) = bulk_pressure(bv, trd, R::splat(rho0) / j, l, resp.wave_speed);
         q = qq;
         qterm = qt;
         // P -= q cof F (zero where the element expands).
@@ -92,7 +91,7 @@ pub fn compute_forces<R: Real, L: Law>(
             // the internal energy (the forces' work), not in the hourglass energy, so the
             // hourglass guard and warning speak only of spurious modes.
             let _stored = physical::add_forces(ph, r.hg_scale, &f, u, r.gamma, r.grad, fe);
-            return finish(out, &f, &pk2, j, q, input, fe);
+            return finish(out, &f, &resp.pk2, j, q, input, fe);
         }
         (HourglassForm::Physical, None) => {
             unreachable!("a physical hourglass group is built with its element frames")
@@ -120,7 +119,7 @@ pub fn compute_forces<R: Real, L: Law>(
     } else {
         out.hourglass_stored = a * sumsq * 0.5;
     }
-    finish(out, &f, &pk2, j, q, input, fe)
+    finish(out, &f, &resp.pk2, j, q, input, fe)
 }
 
 /// The element's Cauchy stress (if asked for) and its fault check, once its forces are summed.

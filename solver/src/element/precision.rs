@@ -1,12 +1,16 @@
 //! Precision of the element kernels: `f64` (the default) or `f32` ([`Precision`]).
 //!
-//! LS-DYNA's explicit solver is single precision by default; its manual advises double precision
-//! for runs beyond about 200k cycles (a palpation takes 15-35k). palpa's `f32` kernels are the
-//! cautious variant described in [`material::real_f32`]: nodal coordinates, displacements and
-//! velocities, the nodal force sums, the laws and their history stay in `f64`; the element
-//! kinematics, hourglass forces, nodal forces and critical step run in eight `f32` lanes, with
-//! the reference data (gradients, hourglass vectors, element frames, Gauss weights) stored in
-//! `f32` ([`NarrowRef`], half the bytes).
+//! LS-DYNA ships single- and double-precision executables and chooses by executable, not by
+//! keyword; single precision is the usual explicit choice, double the advice for long runs
+//! (many cycles, where round-off accumulates in the positions) and for implicit work (ANSYS
+//! LS-DYNA training, lecture 7 "Solution and Simulation Controls", section "LS-DYNA Solver
+//! Precision"). A palpation takes 15-35k cycles. palpa's `f32` kernels are the cautious variant
+//! described in [`material::real_f32`]: nodal coordinates, displacements and velocities, the
+//! nodal force sums, the laws and their history stay in `f64`; the element kinematics, hourglass
+//! forces, nodal forces and critical step run in eight `f32` lanes, reading the reference data
+//! (gradients, hourglass vectors, element frames, Gauss weights) from an `f32` copy
+//! ([`NarrowRef`]): half the bytes read per step, kept beside the `f64` data (so the run holds
+//! half as much again).
 //!
 //! Before a batch is narrowed, each element's nodal coordinates, displacements and velocities are
 //! taken relative to its first node (in `f64`). Every quantity the kernels form from them is
@@ -37,7 +41,8 @@ impl Precision {
         }
     }
 
-    /// From `"f64"` or `"f32"`; the error names the accepted values.
+    /// From `"f64"` (or `"double"`) or `"f32"` (or `"single"`); the error names the accepted
+    /// values.
     pub fn parse(s: &str) -> Result<Precision, String> {
         match s {
             "f64" | "double" => Ok(Precision::F64),
@@ -73,6 +78,16 @@ fn narrow_all<const N: usize, const M: usize>(x: &[[F64x8; N]; M]) -> [[F32x8; N
 }
 
 impl NarrowRef {
+    /// Bytes of the copy (half those of the `f64` data it was made from).
+    pub fn bytes(&self) -> usize {
+        std::mem::size_of_val(self.grad.as_slice())
+            + std::mem::size_of_val(self.gamma.as_slice())
+            + std::mem::size_of_val(self.hg_frame.as_slice())
+            + std::mem::size_of_val(self.hg_inv_len.as_slice())
+            + std::mem::size_of_val(self.gp_grad.as_slice())
+            + std::mem::size_of_val(self.gp_weight.as_slice())
+    }
+
     /// The `f32` copy of a group's reference data.
     pub fn new(
         grad: &[Nodal<F64x8>],
