@@ -98,8 +98,9 @@ def write_inp(path, n, steps, t_ramp):
         f.write("\n".join(out) + "\n")
 
 
-def write_toml(path, n, steps, t_ramp):
-    """palpa scene: `steps` steps of DT (dt_max below the stable step), same press."""
+def write_toml(path, n, steps, t_ramp, precision="f64"):
+    """palpa scene: `steps` steps of DT (dt_max below the stable step), same press, element
+    kernels in `precision` (f64 or f32)."""
     pts = amplitude(t_ramp)
     times = ", ".join(f"{t:.9e}" for t, _ in pts)
     values = ", ".join(f"{-PRESS * a:.9e}" for _, a in pts)
@@ -109,6 +110,7 @@ def write_toml(path, n, steps, t_ramp):
 title = "calculix comparison block"
 end_time = {end!r}
 dt_max = {DT!r}
+precision = "{precision}"
 
 [mesh]
 generator = "box"

@@ -15,7 +15,7 @@ checked: CalculiX's output blocks must fall at the expected times (one every ste
 increments of the fixed increment), palpa's summary.json must report the steps asked for.
 Anything else stops the script with an error.
 
-    python3 benches/calculix/compare.py [--palpa target/release/palpa] [--repeat 3]
+    python3 benches/calculix/compare.py [--palpa target/release/palpa] [--repeat 3] [--precision f32]
 
 Needs Python 3.11 (standard library only); installs Debian's calculix-ccx when `ccx` is missing
 (install_ccx.sh). Scratch files go to --work (default: a temporary directory).
@@ -91,12 +91,12 @@ def run_ccx(work, n, steps, threads, tell=False):
     return wall, dat
 
 
-def run_palpa(work, exe, n, steps, threads):
+def run_palpa(work, exe, n, steps, threads, precision):
     """One palpa run: ((wall s, processor s), summary, history rows, output directory)."""
     d = os.path.join(work, f"palpa{steps}")
     os.makedirs(d, exist_ok=True)
     scene = os.path.join(d, "block.toml")
-    block.write_toml(scene, n, steps, LONG * block.DT)
+    block.write_toml(scene, n, steps, LONG * block.DT, precision)
     out = os.path.join(d, "out")
     env = dict(os.environ, RAYON_NUM_THREADS=str(threads))
     wall, _ = timed([exe, "run", scene, "--out", out, "--quiet"], d, env)
@@ -105,6 +105,8 @@ def run_palpa(work, exe, n, steps, threads):
         fail(f"palpa ran {s.get('steps')} steps, expected {steps} (summary.json)")
     if s.get("threads") != threads:
         fail(f"palpa ran on {s.get('threads')} threads, expected {threads}")
+    if s.get("precision") != precision:
+        fail(f"palpa ran its element kernels in {s.get('precision')}, expected {precision}")
     if not str(s.get("status", "")).startswith("completed"):
         fail(f"palpa status: {s.get('status')}")
     return wall, s, results.palpa_history(os.path.join(out, "history.csv")), out
@@ -117,6 +119,8 @@ def main():
     ap.add_argument("--repeat", type=int, default=3, help="pairs of runs per code (median)")
     ap.add_argument("--threads", type=int, default=2)
     ap.add_argument("--divisions", type=int, default=32, help="elements per edge")
+    ap.add_argument("--precision", choices=["f64", "f32"], default="f64",
+                    help="palpa's element kernels (CalculiX runs in double precision)")
     ap.add_argument("--work", help="scratch directory, kept (default: a temporary one, removed)")
     a = ap.parse_args()
     if a.repeat < 1:
@@ -131,7 +135,7 @@ def main():
     work = a.work or tempfile.mkdtemp(prefix="ccx-compare-")
     os.makedirs(work, exist_ok=True)
     print(f"block: {n}^3 = {ne} hexahedra, dt {block.DT * 1e6:g} us, {a.threads} threads, "
-          f"work in {work}")
+          f"palpa kernels in {a.precision}, work in {work}")
 
     rates = {"ccx": [], "palpa": []}  # (wall rate, processor-time rate) per pair
     last = {}
@@ -140,7 +144,7 @@ def main():
         for steps in (SHORT, LONG):
             t["ccx", steps], last["ccx", steps] = run_ccx(work, n, steps, a.threads, tell=r == 0 and steps == SHORT)
         for steps in (SHORT, LONG):
-            clock, s, hist, out = run_palpa(work, exe, n, steps, a.threads)
+            clock, s, hist, out = run_palpa(work, exe, n, steps, a.threads, a.precision)
             t["palpa", steps], last["palpa", steps] = clock, (s, hist, out)
         for code in rates:
             (w2, c2), (w4, c4) = t[code, SHORT], t[code, LONG]
