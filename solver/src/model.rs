@@ -792,7 +792,7 @@ impl Model {
             if added > ms.max_added * phys {
                 let worst = part_mass
                     .iter()
-                    .max_by(|a, b| a.added.partial_cmp(&b.added).unwrap())
+                    .max_by(|a, b| a.added.total_cmp(&b.added))
                     .map(|p| p.name.clone())
                     .unwrap_or_default();
                 return Err(SolverError::MassScalingLimit {
