@@ -313,7 +313,6 @@ fn lanes_of(x: &[f64], le0: usize) -> F64x8 {
 fn run_chunk_body<L: Law, G: GatherLanes, R: KernelLanes>(l: &L, b: &Batch, ci: usize) -> ChunkOut {
     let g = b.group;
     let n = g.elements.len();
-    let stride = g.history_stride;
     let mut acc = ChunkOut {
         totals: ElementTotals::EMPTY,
         ..Default::default()
@@ -323,118 +322,170 @@ fn run_chunk_body<L: Law, G: GatherLanes, R: KernelLanes>(l: &L, b: &Batch, ci: 
         let le0 = bi * LANES;
         let nvalid = LANES.min(n - le0);
         let conn: [[u32; 8]; LANES] = material::arr![LANES, |q| g.conn[(le0 + q).min(n - 1)]];
-        let ue = G::lanes(b.u, &conn);
-        let ve = G::lanes(b.v, &conn);
-        let xr = G::lanes(b.x_ref, &conn);
-        let xe: Nodal<F64x8> = material::arr![3, |i| material::arr![8, |a| xr[i][a] + ue[i][a]]];
-        let (ue, ve, xe) = (R::nodal(&ue), R::nodal(&ve), R::nodal(&xe));
         let mut fe: Nodal<R> = [[R::zero(); 8]; 3];
-        let fe = &mut fe;
         let s64 = if g.density_scale.is_empty() {
             F64x8::splat(1.0)
         } else {
             lanes_of(&g.density_scale, le0)
         };
-        let s = R::narrow(s64);
-        // SAFETY: batch bi owns history[bi*stride..(bi+1)*stride] alone.
-        let h = unsafe { b.hist.slice(bi * stride, stride) };
-        let o: ElementOut<R> = match b.form {
-            Formulation::OnePoint(hg) => {
-                let rf = one_point::OnePointRef {
-                    grad: &R::grad(g)[bi],
-                    gamma: &R::gamma(g)[bi],
-                    vol0: R::narrow(lanes_of(&g.vol0, le0)),
-                    hg_scale: R::narrow(lanes_of(&g.hg_scale, le0)),
-                    physical: (!g.hg_frame.is_empty()).then(|| PhysicalRef {
-                        frame: &R::hg_frame(g)[bi],
-                        inv_len: &R::hg_inv_len(g)[bi],
-                        young: g.hg_moduli[0],
-                        poisson: g.hg_moduli[1],
-                        shear: g.hg_moduli[2],
-                    }),
-                };
-                one_point::compute_forces(l, &rf, hg.form, &xe, &ue, &ve, s, b.input, h, fe)
-            }
-            Formulation::Full { fbar } => {
-                let rf = full::FullRef {
-                    centre_grad: &R::grad(g)[bi],
-                    gp_grad: &R::gp_grad(g)[bi],
-                    gp_weight: &R::gp_weight(g)[bi],
-                    vol0: R::narrow(lanes_of(&g.vol0, le0)),
-                };
-                full::compute_forces(l, &rf, fbar, &xe, &ue, &ve, s, b.input, h, fe)
-            }
-        };
-        let f64s = |x: R| x.widen().to_array();
-        let (fault_l, fault_v) = (f64s(o.fault), f64s(o.fault_value));
-        let (dt_l, hs_l, hp_l) = (
-            f64s(o.dt),
-            f64s(o.hourglass_stored),
-            f64s(o.hourglass_power),
-        );
-        let (bulk_l, diss_l, s_l) = (f64s(o.bulk_power), f64s(o.law_dissipation), s64.to_array());
-        let mut add = [false; LANES];
-        for q in 0..nvalid {
-            let le = le0 + q;
-            let eroded = !g.eroded.is_empty() && g.eroded[le];
-            let fault = fault_l[q];
-            if eroded || fault != 0.0 {
-                if !eroded && acc.error.is_none() {
-                    let e = fault_error(fault, fault_v[q], l.name());
-                    acc.error = Some((g.elements[le], e.to_string()));
-                }
-                continue;
-            }
-            add[q] = true;
-            let mut dt = dt_l[q];
-            if dt < g.dt_floor {
-                // Run-time mass scaling: dt grows with sqrt(density scale).
-                let r = g.dt_floor / dt;
-                acc.rescale.push((le as u32, s_l[q] * r * r));
-                dt = g.dt_floor;
-            }
-            let (hs, hp) = (hs_l[q], hp_l[q]);
-            let failed = o.failed.lane(q);
-            if failed {
-                acc.failed.push(le as u32);
-            }
-            acc.totals.combine(&ElementTotals {
-                dt_min: dt,
-                dt_elem: g.elements[le],
-                hg_stored: hs,
-                hg_power: hp,
-                hg_peak: hs + hp * b.input.dt,
-                hg_peak_elem: g.elements[le],
-                bulk_power: bulk_l[q],
-                law_dissipation: diss_l[q],
-                newly_eroded: failed as u32,
-                first_eroded: failed.then_some(g.elements[le]),
-            });
-            if let Some(sp) = b.stress {
-                // SAFETY: one element writes one entry.
-                unsafe {
-                    sp.slice(g.elements[le] as usize, 1)[0] =
-                        material::arr![6, |c| o.cauchy[c].lane(q)]
-                };
-            }
-        }
-        // Add the batch's forces into the nodal array, element by element.
-        let fl: [[[f64; LANES]; 8]; 3] =
-            material::arr![3, |i| material::arr![8, |a| fe[i][a].widen().to_array()]];
-        for q in 0..nvalid {
-            if !add[q] {
-                continue;
-            }
-            for a in 0..8 {
-                // SAFETY: no other chunk of this colour has this node (see `Group::colours`).
-                let f = unsafe { &mut b.force.slice(conn[q][a] as usize, 1)[0] };
-                f[0] += fl[0][a][q];
-                f[1] += fl[1][a][q];
-                f[2] += fl[2][a][q];
-            }
-        }
+        let o = batch_forces::<L, G, R>(l, b, bi, &conn, s64, &mut fe);
+        let add = book_lanes(l, b, le0, nvalid, &o, s64, &mut acc);
+        scatter_forces(b, &conn, &add, &fe);
     }
     acc
+}
+
+/// One batch's element kernel: the nodal data gathered into lanes (in `R`, see
+/// [`KernelLanes::nodal`]), the reference data and history of batch `bi`, the forces into `fe`.
+#[inline(always)]
+fn batch_forces<L: Law, G: GatherLanes, R: KernelLanes>(
+    l: &L,
+    b: &Batch,
+    bi: usize,
+    conn: &[[u32; 8]; LANES],
+    density_scale: F64x8,
+    fe: &mut Nodal<R>,
+) -> ElementOut<R> {
+    let g = b.group;
+    let le0 = bi * LANES;
+    let stride = g.history_stride;
+    let ue = G::lanes(b.u, conn);
+    let ve = G::lanes(b.v, conn);
+    let xr = G::lanes(b.x_ref, conn);
+    let xe: Nodal<F64x8> = material::arr![3, |i| material::arr![8, |a| xr[i][a] + ue[i][a]]];
+    let (ue, ve, xe) = (R::nodal(&ue), R::nodal(&ve), R::nodal(&xe));
+    let s = R::narrow(density_scale);
+    // SAFETY: batch bi owns history[bi*stride..(bi+1)*stride] alone.
+    let h = unsafe { b.hist.slice(bi * stride, stride) };
+    match b.form {
+        Formulation::OnePoint(hg) => {
+            let rf = one_point::OnePointRef {
+                grad: &R::grad(g)[bi],
+                gamma: &R::gamma(g)[bi],
+                vol0: R::narrow(lanes_of(&g.vol0, le0)),
+                hg_scale: R::narrow(lanes_of(&g.hg_scale, le0)),
+                physical: (!g.hg_frame.is_empty()).then(|| PhysicalRef {
+                    frame: &R::hg_frame(g)[bi],
+                    inv_len: &R::hg_inv_len(g)[bi],
+                    young: g.hg_moduli[0],
+                    poisson: g.hg_moduli[1],
+                    shear: g.hg_moduli[2],
+                }),
+            };
+            one_point::compute_forces(l, &rf, hg.form, &xe, &ue, &ve, s, b.input, h, fe)
+        }
+        Formulation::Full { fbar } => {
+            let rf = full::FullRef {
+                centre_grad: &R::grad(g)[bi],
+                gp_grad: &R::gp_grad(g)[bi],
+                gp_weight: &R::gp_weight(g)[bi],
+                vol0: R::narrow(lanes_of(&g.vol0, le0)),
+            };
+            full::compute_forces(l, &rf, fbar, &xe, &ue, &ve, s, b.input, h, fe)
+        }
+    }
+}
+
+/// The batch's lanes booked into the chunk's results, element by element: the first fault, the
+/// run-time mass scaling of a step below the group's floor, failed elements, the totals
+/// ([`ElementTotals::combine`]) and the stress. Returns which lanes add their forces (valid,
+/// not eroded, no fault).
+#[inline(always)]
+fn book_lanes<L: Law, R: Real>(
+    l: &L,
+    b: &Batch,
+    le0: usize,
+    nvalid: usize,
+    o: &ElementOut<R>,
+    density_scale: F64x8,
+    acc: &mut ChunkOut,
+) -> [bool; LANES] {
+    let g = b.group;
+    let f64s = |x: R| {
+        let mut a = [0.0; LANES];
+        x.widen().write_to(&mut a);
+        a
+    };
+    let (fault_l, fault_v) = (f64s(o.fault), f64s(o.fault_value));
+    let (dt_l, hs_l, hp_l) = (
+        f64s(o.dt),
+        f64s(o.hourglass_stored),
+        f64s(o.hourglass_power),
+    );
+    let (bulk_l, diss_l) = (f64s(o.bulk_power), f64s(o.law_dissipation));
+    let s_l = density_scale.to_array();
+    let mut add = [false; LANES];
+    for q in 0..nvalid {
+        let le = le0 + q;
+        let eroded = !g.eroded.is_empty() && g.eroded[le];
+        let fault = fault_l[q];
+        if eroded || fault != 0.0 {
+            if !eroded && acc.error.is_none() {
+                let e = fault_error(fault, fault_v[q], l.name());
+                acc.error = Some((g.elements[le], e.to_string()));
+            }
+            continue;
+        }
+        add[q] = true;
+        let mut dt = dt_l[q];
+        if dt < g.dt_floor {
+            // Run-time mass scaling: dt grows with sqrt(density scale).
+            let r = g.dt_floor / dt;
+            acc.rescale.push((le as u32, s_l[q] * r * r));
+            dt = g.dt_floor;
+        }
+        let (hs, hp) = (hs_l[q], hp_l[q]);
+        let failed = o.failed.lane(q);
+        if failed {
+            acc.failed.push(le as u32);
+        }
+        acc.totals.combine(&ElementTotals {
+            dt_min: dt,
+            dt_elem: g.elements[le],
+            hg_stored: hs,
+            hg_power: hp,
+            hg_peak: hs + hp * b.input.dt,
+            hg_peak_elem: g.elements[le],
+            bulk_power: bulk_l[q],
+            law_dissipation: diss_l[q],
+            newly_eroded: failed as u32,
+            first_eroded: failed.then_some(g.elements[le]),
+        });
+        if let Some(sp) = b.stress {
+            // SAFETY: one element writes one entry.
+            unsafe {
+                sp.slice(g.elements[le] as usize, 1)[0] = material::arr![6, |c| o.cauchy[c].lane(q)]
+            };
+        }
+    }
+    add
+}
+
+/// Add the batch's forces into the nodal array, element by element, for the lanes in `add`.
+#[inline(always)]
+fn scatter_forces<R: Real>(
+    b: &Batch,
+    conn: &[[u32; 8]; LANES],
+    add: &[bool; LANES],
+    fe: &Nodal<R>,
+) {
+    let fl: [[[f64; LANES]; 8]; 3] = material::arr![3, |i| material::arr![8, |a| {
+        let mut l = [0.0; LANES];
+        fe[i][a].widen().write_to(&mut l);
+        l
+    }]];
+    for q in 0..LANES {
+        if !add[q] {
+            continue;
+        }
+        for a in 0..8 {
+            // SAFETY: no other chunk of this colour has this node (see `Group::colours`).
+            let f = unsafe { &mut b.force.slice(conn[q][a] as usize, 1)[0] };
+            f[0] += fl[0][a][q];
+            f[1] += fl[1][a][q];
+            f[2] += fl[2][a][q];
+        }
+    }
 }
 
 /// Lane vectors of a nodal field over a batch: `[component][node][lane]` of
