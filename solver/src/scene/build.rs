@@ -1,22 +1,21 @@
 //! Build a [`Scene`] (model, simulation, output plan) from a [`SceneSpec`].
 
-use super::bulk::bulk_knob;
 use super::contact_spec::HandScene;
-use super::def::{DtMin, HourglassGuard, OutputPlan, PartDef, Scene, SceneDef, Setup};
+use super::def::{DtMin, Scene, SceneDef, Setup};
+use super::kinematics;
+use super::locate::Locate;
+use super::loop_settings::{max_steps, run_control, settings};
+use super::node_sets::add_node_sets;
+use super::output_plan::output_plan;
+use super::parts::part_defs;
 use super::spec::*;
-use crate::bc::{Constraint, Kinematic, NodalLoad};
-use crate::element::precision::Precision;
-use crate::element::{BulkViscosity, Formulation, Hourglass, HourglassForm, HourglassModulus};
 use crate::generate::{box_mesh, BoxSpec};
 use crate::mesh::Mesh;
-use crate::model::MassScaling;
 use crate::phantom::Phantom;
-use crate::simulation::DynamicRelaxation;
 use material::quantity::Length;
-use material::Material;
 use std::path::Path;
 
-/// A scene error with its location.
+/// A scene error with its location ([`Locate::err`]).
 fn err(
     path: &Path,
     src: &str,
@@ -24,11 +23,7 @@ fn err(
     needle: Option<&str>,
     msg: impl std::fmt::Display,
 ) -> String {
-    let line = needle.and_then(|n| src.lines().position(|l| l.contains(n)).map(|i| i + 1));
-    match line {
-        Some(l) => format!("{}:{}: `{}`: {}", path.display(), l, key, msg),
-        None => format!("{}: `{}`: {}", path.display(), key, msg),
-    }
+    Locate { path, src }.err(key, needle, &msg)
 }
 
 /// Read, parse and build a scene file.
@@ -43,15 +38,6 @@ pub fn load_scene_with(path: &Path, prebuilt: Option<Phantom>) -> Result<Scene, 
     let spec: SceneSpec = toml::from_str(&src)
         .map_err(|e| format!("{}: {}", path.display(), e.to_string().trim_end()))?;
     build_scene_with(spec, path, &src, prebuilt)
-}
-
-fn axis(s: &str) -> Option<usize> {
-    match s {
-        "x" => Some(0),
-        "y" => Some(1),
-        "z" => Some(2),
-        _ => None,
-    }
 }
 
 fn read_mesh(
@@ -193,63 +179,6 @@ fn mesh_units(spec: &MeshSpec, file: &Path) -> Result<f64, String> {
     }
 }
 
-fn formulation(p: &PartSpec) -> Result<Formulation, String> {
-    let form = match p.hourglass.as_deref() {
-        None | Some("viscous") => HourglassForm::Viscous,
-        Some("stiffness") => HourglassForm::Stiffness,
-        Some("physical") => HourglassForm::Physical,
-        Some(o) => {
-            return Err(format!(
-                "hourglass must be `viscous`, `stiffness` or `physical`, got `{o}`"
-            ))
-        }
-    };
-    // The physical form's coefficient scales an energy that is exact at 1.
-    let default_q = if form == HourglassForm::Physical {
-        1.0
-    } else {
-        0.1
-    };
-    let q = p.hourglass_coefficient.map(|x| x.0).unwrap_or(default_q);
-    if !(0.0..=1.0).contains(&q) {
-        return Err(format!("hourglass_coefficient must lie in [0, 1], got {q}"));
-    }
-    if form == HourglassForm::Physical && p.hourglass_modulus.is_some() {
-        return Err(
-            "hourglass_modulus does not apply to `physical` hourglass control (it uses Young's and the shear modulus of the law)"
-                .into(),
-        );
-    }
-    let modulus = match p.hourglass_modulus.as_deref() {
-        None | Some("p_wave") => HourglassModulus::PWave,
-        Some("shear") => HourglassModulus::Shear,
-        Some(o) => {
-            return Err(format!(
-                "hourglass_modulus must be `p_wave` or `shear`, got `{o}`"
-            ))
-        }
-    };
-    Ok(match p.formulation.as_deref() {
-        None | Some("one_point") => Formulation::OnePoint(Hourglass {
-            form,
-            coefficient: q,
-            modulus,
-        }),
-        Some("full_fbar") | Some("full")
-            if p.hourglass.is_some() || p.hourglass_modulus.is_some() =>
-        {
-            return Err("hourglass control applies to one_point elements only".into())
-        }
-        Some("full_fbar") => Formulation::Full { fbar: true },
-        Some("full") => Formulation::Full { fbar: false },
-        Some(o) => {
-            return Err(format!(
-                "formulation must be `one_point`, `full_fbar` or `full`, got `{o}`"
-            ))
-        }
-    })
-}
-
 /// Build a scene from its parsed spec. `path` and `src` are used for error messages and to
 /// resolve relative file names.
 pub fn build_scene(spec: SceneSpec, path: &Path, src: &str) -> Result<Scene, String> {
@@ -267,9 +196,7 @@ pub fn build_scene_with(
     super::def::assemble(resolve_scene(spec, path, src, prebuilt)?)
 }
 
-/// The most history rows, or frames, a scene may ask for unless `[output] max_outputs` raises
-/// the limit.
-pub const DEFAULT_MAX_OUTPUTS: f64 = 1e6;
+pub use super::output_plan::DEFAULT_MAX_OUTPUTS;
 
 /// Resolve a parsed scene to SI ([`SceneDef`]): the mesh with its node sets, the parts' laws,
 /// boundary conditions, loads, settings, output and contact. [`super::def::assemble`] builds
@@ -280,452 +207,25 @@ pub fn resolve_scene(
     src: &str,
     prebuilt: Option<Phantom>,
 ) -> Result<SceneDef, String> {
-    let e = |key: &str, needle: Option<&str>, msg: &dyn std::fmt::Display| {
-        err(path, src, key, needle, msg)
-    };
-    let end_time = spec.run.end_time.0;
-    if !(end_time > 0.0) {
-        return Err(e("run.end_time", Some("end_time"), &"must be positive"));
-    }
-    if !end_time.is_finite() {
-        return Err(e(
-            "run.end_time",
-            Some("end_time"),
-            &format!("must be finite, got {end_time}"),
-        ));
-    }
-    let dt_factor = spec
-        .run
-        .dt_factor
-        .map(|x| x.0)
-        .unwrap_or(crate::simulation::DEFAULT_DT_FACTOR);
-    if !(dt_factor > 0.0 && dt_factor <= 1.0) {
-        return Err(e(
-            "run.dt_factor",
-            Some("dt_factor"),
-            &format!("must lie in (0, 1], got {dt_factor}"),
-        ));
-    }
-    let precision = match &spec.run.precision {
-        None => Precision::F64,
-        Some(p) => Precision::parse(p).map_err(|m| e("run.precision", Some("precision"), &m))?,
-    };
+    let at = Locate { path, src };
+    let (end_time, dt_factor, precision) = run_control(&spec.run, at)?;
     let mut notes = Vec::new();
     let (mut mesh, mut phantom) = read_mesh(&spec.mesh, path, src, prebuilt, &mut notes)?;
     for (i, h) in spec.hands.iter_mut().enumerate() {
         place_hand(h, phantom.as_ref())
-            .map_err(|m| e(&format!("hand[{i}]"), Some(&format!("\"{}\"", h.name)), &m))?;
+            .map_err(|m| at.err(&format!("hand[{i}]"), Some(&format!("\"{}\"", h.name)), &m))?;
     }
     if let Some(ph) = phantom.as_mut() {
         // the scene owns the mesh from here on; keep the phantom's other data
         ph.mesh = Mesh::default();
     }
-    // Node sets.
-    for (name, ns) in &spec.node_sets {
-        let key = format!("node_sets.{name}");
-        let mut nodes: Vec<u32> = Vec::new();
-        let mut given = 0;
-        if let (Some(lo), Some(hi)) = (ns.box_min, ns.box_max) {
-            nodes.extend(
-                mesh.nodes_in_box([lo[0].0, lo[1].0, lo[2].0], [hi[0].0, hi[1].0, hi[2].0]),
-            );
-            given += 1;
-        }
-        if let (Some(ax), Some(val)) = (&ns.plane_axis, ns.plane_value) {
-            let a = axis(ax)
-                .ok_or_else(|| e(&key, Some("plane_axis"), &"plane_axis must be x, y or z"))?;
-            nodes.extend(mesh.nodes_on_plane(a, val.0, ns.tolerance.map(|t| t.0).unwrap_or(1e-9)));
-            given += 1;
-        }
-        if let Some(ids) = &ns.nodes {
-            if let Some(bad) = ids.iter().find(|&&n| n as usize >= mesh.nodes.len()) {
-                return Err(e(
-                    &key,
-                    Some(&format!("[node_sets.{name}]")),
-                    &format!("node {bad} does not exist"),
-                ));
-            }
-            nodes.extend(ids);
-            given += 1;
-        }
-        if given != 1 {
-            return Err(e(
-                &key,
-                Some(&format!("[node_sets.{name}]")),
-                &"give exactly one of box_min+box_max, plane_axis+plane_value, nodes",
-            ));
-        }
-        nodes.sort_unstable();
-        nodes.dedup();
-        if nodes.is_empty() {
-            return Err(e(
-                &key,
-                Some(&format!("[node_sets.{name}]")),
-                &"selects no node",
-            ));
-        }
-        mesh.node_sets.insert(name.clone(), nodes);
-    }
-    let all: Vec<u32> = (0..mesh.nodes.len() as u32).collect();
-    let set = |name: &str, key: &str| -> Result<Vec<u32>, String> {
-        if name == "all" {
-            return Ok(all.clone());
-        }
-        mesh.node_sets.get(name).cloned().ok_or_else(|| {
-            let known: Vec<&String> = mesh.node_sets.keys().collect();
-            e(
-                key,
-                Some(&format!("\"{name}\"")),
-                &format!("no node set `{name}`; known: all, {known:?}"),
-            )
-        })
-    };
-    // Materials and parts.
-    let mut parts = Vec::new();
-    if spec.parts.is_empty() {
-        return Err(e("part", None, &"the scene defines no [[part]]"));
-    }
-    for pname in &mesh.part_names {
-        let ps = spec
-            .parts
-            .iter()
-            .find(|p| &p.name == pname)
-            .ok_or_else(|| {
-                e(
-                    "part",
-                    None,
-                    &format!("the mesh has a part `{pname}` but no [[part]] gives it a material"),
-                )
-            })?;
-        let key = format!("part `{pname}`");
-        let base = path.parent();
-        let material: Material = match spec.materials.get(&ps.material) {
-            Some(card) => card.build_in(&ps.material, base).map_err(|m| {
-                e(
-                    &format!("materials.{}", ps.material),
-                    Some(&format!("[materials.{}]", ps.material)),
-                    &m,
-                )
-            })?,
-            None if material::library::is_library_name(&ps.material) => {
-                material::named(&ps.material)
-                    .and_then(|c| c.build_in(&ps.material, base))
-                    .map_err(|m| e(&format!("{key}.material"), Some(&ps.material), &m))?
-            }
-            None => {
-                let known: Vec<&String> = spec.materials.keys().collect();
-                return Err(e(
-                    &format!("{key}.material"),
-                    Some(&format!("\"{}\"", ps.material)),
-                    &format!(
-                        "no material `{}`; known: {known:?} or a library name such as paper:liver",
-                        ps.material
-                    ),
-                ));
-            }
-        };
-        let formulation =
-            formulation(ps).map_err(|m| e(&key, Some(&format!("\"{pname}\"")), &m))?;
-        let card = match spec.materials.get(&ps.material) {
-            Some(card) => card.clone(),
-            None => material::named(&ps.material)
-                .map_err(|m| e(&format!("{key}.material"), Some(&ps.material), &m))?,
-        };
-        let (material, card, bulk) = bulk_knob(ps, material, card)
-            .map_err(|m| e(&key, Some(&format!("\"{pname}\"")), &m))?;
-        if let Some(b) = &bulk {
-            notes.push(b.describe());
-        }
-        parts.push(PartDef {
-            name: pname.clone(),
-            material,
-            spec: card,
-            formulation,
-            bulk,
-        });
-    }
-    for ps in &spec.parts {
-        if !mesh.part_names.contains(&ps.name) {
-            return Err(e(
-                "part.name",
-                Some(&format!("\"{}\"", ps.name)),
-                &format!(
-                    "the mesh has no part `{}`; its parts: {:?}",
-                    ps.name, mesh.part_names
-                ),
-            ));
-        }
-    }
-    // Boundary conditions.
-    let mut constraints = Vec::new();
-    for (i, b) in spec.boundaries.iter().enumerate() {
-        let key = format!("boundary[{i}]");
-        let nodes = set(&b.nodes, &format!("{key}.nodes"))?;
-        let mut fixed = [false; 3];
-        if let Some(f) = &b.fix {
-            for d in f {
-                if d == "all" {
-                    fixed = [true; 3];
-                } else {
-                    let a = axis(d).ok_or_else(|| {
-                        e(
-                            &format!("{key}.fix"),
-                            Some("fix"),
-                            &format!("`{d}` is not x, y, z or all"),
-                        )
-                    })?;
-                    fixed[a] = true;
-                }
-            }
-        }
-        if let Some(s) = &b.symmetry {
-            let a = axis(s).ok_or_else(|| {
-                e(
-                    &format!("{key}.symmetry"),
-                    Some("symmetry"),
-                    &format!("`{s}` is not x, y or z"),
-                )
-            })?;
-            fixed[a] = true;
-        }
-        for (a, f) in fixed.iter().enumerate() {
-            if *f {
-                constraints.push(Constraint {
-                    nodes: nodes.clone(),
-                    dof: a,
-                    kind: Kinematic::Fixed,
-                });
-            }
-        }
-        if let Some(d) = &b.displacement {
-            for (a, c) in [&d.x, &d.y, &d.z].into_iter().enumerate() {
-                if let Some(c) = c {
-                    let cv = c
-                        .boundary_curve()
-                        .map_err(|m| e(&format!("{key}.displacement"), Some("displacement"), &m))?;
-                    constraints.push(Constraint {
-                        nodes: nodes.clone(),
-                        dof: a,
-                        kind: Kinematic::Displacement(cv),
-                    });
-                }
-            }
-        }
-        if let Some(d) = &b.velocity {
-            for (a, c) in [&d.x, &d.y, &d.z].into_iter().enumerate() {
-                if let Some(c) = c {
-                    let cv = c
-                        .boundary_curve()
-                        .map_err(|m| e(&format!("{key}.velocity"), Some("velocity"), &m))?;
-                    constraints.push(Constraint {
-                        nodes: nodes.clone(),
-                        dof: a,
-                        kind: Kinematic::Velocity(cv),
-                    });
-                }
-            }
-        }
-    }
-    let mut loads = Vec::new();
-    for (i, l) in spec.loads.iter().enumerate() {
-        let key = format!("load[{i}]");
-        let nodes = set(&l.nodes, &format!("{key}.nodes"))?;
-        let share = if l.total.unwrap_or(false) {
-            1.0 / nodes.len() as f64
-        } else {
-            1.0
-        };
-        for (a, c) in [&l.force.x, &l.force.y, &l.force.z].into_iter().enumerate() {
-            if let Some(c) = c {
-                let cv = c
-                    .boundary_curve()
-                    .map_err(|m| e(&format!("{key}.force"), Some("force"), &m))?
-                    .scaled(share);
-                loads.push(NodalLoad {
-                    nodes: nodes.clone(),
-                    dof: a,
-                    curve: cv,
-                });
-            }
-        }
-    }
-    let mut initial_velocity = Vec::new();
-    for (i, iv) in spec.initial_velocities.iter().enumerate() {
-        let nodes = set(&iv.nodes, &format!("initial_velocity[{i}].nodes"))?;
-        initial_velocity.push((
-            nodes,
-            [iv.velocity[0].0, iv.velocity[1].0, iv.velocity[2].0],
-        ));
-    }
-    // Output plan.
-    let out = &spec.output;
-    let known = [
-        "displacement",
-        "velocity",
-        "part",
-        "stress",
-        "von_mises",
-        "max_principal",
-        "history",
-    ];
-    let fields = out.fields.clone().unwrap_or_else(|| {
-        vec![
-            "displacement".into(),
-            "velocity".into(),
-            "part".into(),
-            "von_mises".into(),
-        ]
-    });
-    for f in &fields {
-        if !known.contains(&f.as_str()) {
-            return Err(e(
-                "output.fields",
-                Some(&format!("\"{f}\"")),
-                &format!("unknown field `{f}`; known: {known:?}"),
-            ));
-        }
-    }
-    let mut reactions = Vec::new();
-    for r in out.reactions.clone().unwrap_or_default() {
-        let nodes = set(&r, "output.reactions")?;
-        reactions.push((r, nodes));
-    }
-    let vtk_interval = if out.vtk == Some(false) {
-        None
-    } else {
-        Some(out.interval.map(|t| t.0).unwrap_or(end_time / 10.0))
-    };
-    let history_interval = out
-        .history_interval
-        .map(|t| t.0)
-        .unwrap_or(end_time / 500.0);
-    if !(history_interval >= 0.0 && history_interval.is_finite()) {
-        return Err(e(
-            "output.history_interval",
-            Some("history_interval"),
-            &format!(
-                "must be zero (every step) or a positive finite time, got {history_interval} s"
-            ),
-        ));
-    }
-    let max_outputs = match out.max_outputs.map(|x| x.0) {
-        None => DEFAULT_MAX_OUTPUTS,
-        Some(m) if m >= 1.0 && m.is_finite() => m,
-        Some(m) => {
-            return Err(e(
-                "output.max_outputs",
-                Some("max_outputs"),
-                &format!("must be a positive finite count, got {m}"),
-            ))
-        }
-    };
-    // Outputs on the interval grid: a tiny interval would write rows or frames without end
-    // (and stall the run) rather than fail.
-    let too_many = |key: &str, needle: &str, what: &str, interval: f64| {
-        let n = end_time / interval;
-        (interval > 0.0 && n > max_outputs).then(|| {
-            e(
-                key,
-                Some(needle),
-                &format!(
-                    "an interval of {interval:e} s over end_time {end_time:e} s gives {n:.3e} {what}, more than the limit of {max_outputs:.0}; use a longer interval, or raise `[output] max_outputs` if you mean it"
-                ),
-            )
-        })
-    };
-    if let Some(m) = too_many(
-        "output.history_interval",
-        "history_interval",
-        "history rows",
-        history_interval,
-    ) {
-        return Err(m);
-    }
-    let probe = match &out.probe {
-        None => None,
-        Some(name) => {
-            let els = mesh.element_sets.get(name).cloned().ok_or_else(|| {
-                let known: Vec<&String> = mesh.element_sets.keys().collect();
-                e(
-                    "output.probe",
-                    Some("probe"),
-                    &format!("no element set `{name}`; known: {known:?}"),
-                )
-            })?;
-            Some((name.clone(), els))
-        }
-    };
-    let frame_interval = out.interval.map(|t| t.0).unwrap_or(end_time / 10.0);
-    if !(frame_interval > 0.0) {
-        return Err(e("output.interval", Some("interval"), &"must be positive"));
-    }
-    if let Some(m) = too_many("output.interval", "interval", "frames", frame_interval) {
-        return Err(m);
-    }
-    let plan = OutputPlan {
-        vtk_interval,
-        frame_interval: (vtk_interval.is_some() || probe.is_some()).then_some(frame_interval),
-        history_interval,
-        fields,
-        reactions,
-        probe,
-    };
-    // Settings.
-    let bulk = match &spec.bulk_viscosity {
-        Some(b) if b.enabled == Some(false) => None,
-        Some(b) => {
-            let quadratic = b.quadratic.map(|x| x.0).unwrap_or(1.5);
-            let linear = b.linear.map(|x| x.0).unwrap_or(0.06);
-            for (key, v) in [("quadratic", quadratic), ("linear", linear)] {
-                if !(v >= 0.0 && v.is_finite()) {
-                    return Err(e(
-                        &format!("bulk_viscosity.{key}"),
-                        Some(key),
-                        &format!("must be zero or a positive finite coefficient, got {v}"),
-                    ));
-                }
-            }
-            Some(BulkViscosity { quadratic, linear })
-        }
-        None => Some(BulkViscosity::default()),
-    };
-    let mass_scaling = spec.mass_scaling.as_ref().map(|m| MassScaling {
-        target: m.target_dt,
-        max_added: m.max_added.map(|x| x.0).unwrap_or(0.05),
-    });
-    let damping = spec
-        .damping
-        .as_ref()
-        .map(|d| d.mass_proportional.0)
-        .filter(|&a| a != 0.0);
-    let gravity = spec
-        .gravity
-        .as_ref()
-        .map(|g| {
-            [
-                g.acceleration[0].0,
-                g.acceleration[1].0,
-                g.acceleration[2].0,
-            ]
-        })
-        .filter(|g| g.iter().any(|&x| x != 0.0));
-    let relaxation = spec.relaxation.as_ref().map(|r| DynamicRelaxation {
-        tolerance: r.tolerance.map(|x| x.0).unwrap_or(1e-10),
-    });
-    let hourglass_guard = match spec.run.max_hourglass_ratio {
-        Some(r) if !(r.0 > 0.0) => {
-            return Err(format!(
-                "{}: run.max_hourglass_ratio must be positive (got {})",
-                path.display(),
-                r.0
-            ))
-        }
-        Some(r) => Some(HourglassGuard {
-            ratio: r.0,
-            after: spec.run.hourglass_check_after.map(|t| t.0),
-        }),
-        None => None,
-    };
+    add_node_sets(&spec.node_sets, &mut mesh, at)?;
+    let parts = part_defs(&spec, &mesh, at, &mut notes)?;
+    let constraints = kinematics::constraints(&spec, &mesh, at)?;
+    let loads = kinematics::loads(&spec, &mesh, at)?;
+    let initial_velocity = kinematics::initial_velocities(&spec, &mesh, at)?;
+    let output = output_plan(&spec.output, end_time, &mesh, at)?;
+    let st = settings(&spec, at)?;
     // Contact exists only when the scene has indenters or hands.
     let contact = if !spec.indenters.is_empty() || !spec.hands.is_empty() {
         Some(crate::contact_stage::resolve_contact(
@@ -748,24 +248,14 @@ pub fn resolve_scene(
         precision,
         dt_max: spec.run.dt_max.map(|t| t.0),
         dt_min: spec.run.dt_min.map(|t| DtMin::Time(t.0)),
-        max_steps: match spec.run.max_steps.map(|x| x.0) {
-            None => None,
-            Some(m) if m >= 1.0 && m.is_finite() => Some(m),
-            Some(m) => {
-                return Err(e(
-                    "run.max_steps",
-                    Some("max_steps"),
-                    &format!("must be a positive finite count, got {m}"),
-                ))
-            }
-        },
-        hourglass_guard,
-        bulk,
-        damping,
-        gravity,
-        relaxation,
-        mass_scaling,
-        output: plan,
+        max_steps: max_steps(&spec.run, at)?,
+        hourglass_guard: st.hourglass_guard,
+        bulk: st.bulk,
+        damping: st.damping,
+        gravity: st.gravity,
+        relaxation: st.relaxation,
+        mass_scaling: st.mass_scaling,
+        output,
         contact,
     };
     Ok(SceneDef {
