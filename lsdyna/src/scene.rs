@@ -1003,17 +1003,10 @@ fn build(cx: &mut Ctx, path: &Path) -> Result<SceneDef, Vec<String>> {
     bail!();
 
     // Output.
-    let mut fields: Vec<String> = [
-        "displacement",
-        "velocity",
-        "part",
-        "stress",
-        "von_mises",
-        "max_principal",
-    ]
-    .iter()
-    .map(|s| s.to_string())
-    .collect();
+    let mut fields: Vec<String> = solver::scene::output_plan::VTK_FIELDS
+        .iter()
+        .map(|s| s.to_string())
+        .collect();
     let vtk_interval = match &d.d3plot {
         None => None,
         Some(p) => {

@@ -298,12 +298,14 @@ impl Group {
     /// Bytes of the reference data the `f64` kernels read (gradients, hourglass vectors and
     /// frames, Gauss-point gradients and weights).
     pub fn reference_bytes(&self) -> usize {
-        std::mem::size_of_val(self.grad.as_slice())
-            + std::mem::size_of_val(self.gamma.as_slice())
-            + std::mem::size_of_val(self.hg_frame.as_slice())
-            + std::mem::size_of_val(self.hg_inv_len.as_slice())
-            + std::mem::size_of_val(self.gp_grad.as_slice())
-            + std::mem::size_of_val(self.gp_weight.as_slice())
+        crate::element::precision::reference_bytes(
+            &self.grad,
+            &self.gamma,
+            &self.hg_frame,
+            &self.hg_inv_len,
+            &self.gp_grad,
+            &self.gp_weight,
+        )
     }
 
     /// History value `k` of integration point `ip` of group-local element `le`.

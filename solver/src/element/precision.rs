@@ -77,15 +77,35 @@ fn narrow_all<const N: usize, const M: usize>(x: &[[F64x8; N]; M]) -> [[F32x8; N
     x.map(|row| row.map(F32x8::narrow))
 }
 
+/// Bytes of a group's reference data in either precision: gradients, hourglass vectors,
+/// element frames and inverse half-lengths, Gauss-point gradients and weights.
+pub fn reference_bytes<A, B, C, D, E, F>(
+    grad: &[A],
+    gamma: &[B],
+    hg_frame: &[C],
+    hg_inv_len: &[D],
+    gp_grad: &[E],
+    gp_weight: &[F],
+) -> usize {
+    std::mem::size_of_val(grad)
+        + std::mem::size_of_val(gamma)
+        + std::mem::size_of_val(hg_frame)
+        + std::mem::size_of_val(hg_inv_len)
+        + std::mem::size_of_val(gp_grad)
+        + std::mem::size_of_val(gp_weight)
+}
+
 impl NarrowRef {
     /// Bytes of the copy (half those of the `f64` data it was made from).
     pub fn bytes(&self) -> usize {
-        std::mem::size_of_val(self.grad.as_slice())
-            + std::mem::size_of_val(self.gamma.as_slice())
-            + std::mem::size_of_val(self.hg_frame.as_slice())
-            + std::mem::size_of_val(self.hg_inv_len.as_slice())
-            + std::mem::size_of_val(self.gp_grad.as_slice())
-            + std::mem::size_of_val(self.gp_weight.as_slice())
+        reference_bytes(
+            &self.grad,
+            &self.gamma,
+            &self.hg_frame,
+            &self.hg_inv_len,
+            &self.gp_grad,
+            &self.gp_weight,
+        )
     }
 
     /// The `f32` copy of a group's reference data.

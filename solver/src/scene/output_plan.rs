@@ -7,6 +7,16 @@ use super::node_sets::node_set;
 use super::spec::OutputSpec;
 use crate::mesh::Mesh;
 
+/// The fields a VTK frame can carry (`[output] fields`, which also takes `history`).
+pub const VTK_FIELDS: [&str; 6] = [
+    "displacement",
+    "velocity",
+    "part",
+    "stress",
+    "von_mises",
+    "max_principal",
+];
+
 /// The most history rows, or frames, a scene may ask for unless `[output] max_outputs` raises
 /// the limit.
 pub const DEFAULT_MAX_OUTPUTS: f64 = 1e6;
@@ -18,15 +28,7 @@ pub(crate) fn output_plan(
     mesh: &Mesh,
     at: Locate,
 ) -> Result<OutputPlan, String> {
-    let known = [
-        "displacement",
-        "velocity",
-        "part",
-        "stress",
-        "von_mises",
-        "max_principal",
-        "history",
-    ];
+    let known: Vec<&str> = VTK_FIELDS.iter().copied().chain(["history"]).collect();
     let fields = out.fields.clone().unwrap_or_else(|| {
         vec![
             "displacement".into(),
