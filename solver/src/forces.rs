@@ -26,7 +26,7 @@
 //! by element in element order, both by [`ElementTotals::combine`], for the same reason.
 
 use crate::element::physical::PhysicalRef;
-use crate::element::precision::{NarrowRef, Precision};
+use crate::element::precision::{NarrowRef, Precision, Refs};
 use crate::element::{fault_error, full, one_point, ElementOut, Formulation, Nodal, StepInput};
 use crate::model::{ChunkOut, ElementTotals, Group, Part, CHUNK};
 use material::real::{F64x8, Mask, Real, LANES};
@@ -127,14 +127,7 @@ pub fn element_loop(
         let part = &parts[g.part];
         let n = g.elements.len();
         if input.precision == Precision::F32 && g.narrow.is_none() {
-            g.narrow = Some(Box::new(NarrowRef::new(
-                &g.grad,
-                &g.gamma,
-                &g.hg_frame,
-                &g.hg_inv_len,
-                &g.gp_grad,
-                &g.gp_weight,
-            )));
+            g.narrow = Some(Box::new(NarrowRef::new(&g.refs())));
         }
         let mut chunks = std::mem::take(&mut g.chunks);
         let chunk_ptr = Shared(chunks.as_mut_ptr());
@@ -218,12 +211,7 @@ unsafe fn run_chunk_avx512<L: Law, R: KernelLanes>(l: &L, b: &Batch, ci: usize) 
 /// The number types the element kernels run in ([`F64x8`], [`F32x8`]), and where each finds
 /// its reference data: the group's own (`f64`) or its [`NarrowRef`] (`f32`).
 trait KernelLanes: Real<Wide = F64x8> {
-    fn grad(g: &Group) -> &[Nodal<Self>];
-    fn gamma(g: &Group) -> &[[[Self; 8]; 4]];
-    fn hg_frame(g: &Group) -> &[[[Self; 3]; 3]];
-    fn hg_inv_len(g: &Group) -> &[[Self; 3]];
-    fn gp_grad(g: &Group) -> &[[Nodal<Self>; 8]];
-    fn gp_weight(g: &Group) -> &[[Self; 8]];
+    fn refs(g: &Group) -> Refs<'_, Self>;
     /// A batch's nodal field in the kernel's number type: as it is in `f64`; relative to each
     /// element's first node before rounding in `f32` (see [`crate::element::precision`]).
     fn nodal(x: &Nodal<F64x8>) -> Nodal<Self>;
@@ -231,28 +219,8 @@ trait KernelLanes: Real<Wide = F64x8> {
 
 impl KernelLanes for F64x8 {
     #[inline(always)]
-    fn grad(g: &Group) -> &[Nodal<Self>] {
-        &g.grad
-    }
-    #[inline(always)]
-    fn gamma(g: &Group) -> &[[[Self; 8]; 4]] {
-        &g.gamma
-    }
-    #[inline(always)]
-    fn hg_frame(g: &Group) -> &[[[Self; 3]; 3]] {
-        &g.hg_frame
-    }
-    #[inline(always)]
-    fn hg_inv_len(g: &Group) -> &[[Self; 3]] {
-        &g.hg_inv_len
-    }
-    #[inline(always)]
-    fn gp_grad(g: &Group) -> &[[Nodal<Self>; 8]] {
-        &g.gp_grad
-    }
-    #[inline(always)]
-    fn gp_weight(g: &Group) -> &[[Self; 8]] {
-        &g.gp_weight
+    fn refs(g: &Group) -> Refs<'_, Self> {
+        g.refs()
     }
     #[inline(always)]
     fn nodal(x: &Nodal<F64x8>) -> Nodal<Self> {
@@ -260,38 +228,13 @@ impl KernelLanes for F64x8 {
     }
 }
 
-/// The group's [`NarrowRef`], which [`element_loop`] builds before an `f32` step.
-#[inline(always)]
-fn narrow_ref(g: &Group) -> &NarrowRef {
-    g.narrow
-        .as_deref()
-        .expect("element_loop builds the f32 reference data first")
-}
-
 impl KernelLanes for F32x8 {
     #[inline(always)]
-    fn grad(g: &Group) -> &[Nodal<Self>] {
-        &narrow_ref(g).grad
-    }
-    #[inline(always)]
-    fn gamma(g: &Group) -> &[[[Self; 8]; 4]] {
-        &narrow_ref(g).gamma
-    }
-    #[inline(always)]
-    fn hg_frame(g: &Group) -> &[[[Self; 3]; 3]] {
-        &narrow_ref(g).hg_frame
-    }
-    #[inline(always)]
-    fn hg_inv_len(g: &Group) -> &[[Self; 3]] {
-        &narrow_ref(g).hg_inv_len
-    }
-    #[inline(always)]
-    fn gp_grad(g: &Group) -> &[[Nodal<Self>; 8]] {
-        &narrow_ref(g).gp_grad
-    }
-    #[inline(always)]
-    fn gp_weight(g: &Group) -> &[[Self; 8]] {
-        &narrow_ref(g).gp_weight
+    fn refs(g: &Group) -> Refs<'_, Self> {
+        g.narrow
+            .as_deref()
+            .expect("element_loop builds the f32 reference data first")
+            .refs()
     }
     #[inline(always)]
     fn nodal(x: &Nodal<F64x8>) -> Nodal<Self> {
@@ -317,6 +260,8 @@ fn run_chunk_body<L: Law, G: GatherLanes, R: KernelLanes>(l: &L, b: &Batch, ci: 
         totals: ElementTotals::EMPTY,
         ..Default::default()
     };
+    // the group's reference data in R, looked up once per chunk
+    let refs = R::refs(g);
     let first = ci * (CHUNK / LANES);
     for bi in first..g.batches().min(first + CHUNK / LANES) {
         let le0 = bi * LANES;
@@ -328,7 +273,7 @@ fn run_chunk_body<L: Law, G: GatherLanes, R: KernelLanes>(l: &L, b: &Batch, ci: 
         } else {
             lanes_of(&g.density_scale, le0)
         };
-        let o = batch_forces::<L, G, R>(l, b, bi, &conn, s64, &mut fe);
+        let o = batch_forces::<L, G, R>(l, b, &refs, bi, &conn, s64, &mut fe);
         let add = book_lanes(l, b, le0, nvalid, &o, s64, &mut acc);
         scatter_forces(b, &conn, &add, &fe);
     }
@@ -341,6 +286,7 @@ fn run_chunk_body<L: Law, G: GatherLanes, R: KernelLanes>(l: &L, b: &Batch, ci: 
 fn batch_forces<L: Law, G: GatherLanes, R: KernelLanes>(
     l: &L,
     b: &Batch,
+    refs: &Refs<R>,
     bi: usize,
     conn: &[[u32; 8]; LANES],
     density_scale: F64x8,
@@ -360,13 +306,13 @@ fn batch_forces<L: Law, G: GatherLanes, R: KernelLanes>(
     match b.form {
         Formulation::OnePoint(hg) => {
             let rf = one_point::OnePointRef {
-                grad: &R::grad(g)[bi],
-                gamma: &R::gamma(g)[bi],
+                grad: &refs.grad[bi],
+                gamma: &refs.gamma[bi],
                 vol0: R::narrow(lanes_of(&g.vol0, le0)),
                 hg_scale: R::narrow(lanes_of(&g.hg_scale, le0)),
                 physical: (!g.hg_frame.is_empty()).then(|| PhysicalRef {
-                    frame: &R::hg_frame(g)[bi],
-                    inv_len: &R::hg_inv_len(g)[bi],
+                    frame: &refs.hg_frame[bi],
+                    inv_len: &refs.hg_inv_len[bi],
                     young: g.hg_moduli[0],
                     poisson: g.hg_moduli[1],
                     shear: g.hg_moduli[2],
@@ -376,9 +322,9 @@ fn batch_forces<L: Law, G: GatherLanes, R: KernelLanes>(
         }
         Formulation::Full { fbar } => {
             let rf = full::FullRef {
-                centre_grad: &R::grad(g)[bi],
-                gp_grad: &R::gp_grad(g)[bi],
-                gp_weight: &R::gp_weight(g)[bi],
+                centre_grad: &refs.grad[bi],
+                gp_grad: &refs.gp_grad[bi],
+                gp_weight: &refs.gp_weight[bi],
                 vol0: R::narrow(lanes_of(&g.vol0, le0)),
             };
             full::compute_forces(l, &rf, fbar, &xe, &ue, &ve, s, b.input, h, fe)

@@ -15,7 +15,7 @@
 //! (dt_t / (s_f L/c))^2, which raises its step to exactly dt_t; other elements are untouched.
 //! The added mass is reported per part.
 
-use crate::element::precision::NarrowRef;
+use crate::element::precision::{NarrowRef, Refs};
 use crate::element::{max_face_area, Nodal};
 use crate::element::{physical, surface_mode_factor, Formulation, HourglassForm, HourglassModulus};
 use crate::hex::{element_geometry, hourglass_gamma};
@@ -295,17 +295,16 @@ impl Group {
         self.elements.len().div_ceil(LANES)
     }
 
-    /// Bytes of the reference data the `f64` kernels read (gradients, hourglass vectors and
-    /// frames, Gauss-point gradients and weights).
-    pub fn reference_bytes(&self) -> usize {
-        crate::element::precision::reference_bytes(
-            &self.grad,
-            &self.gamma,
-            &self.hg_frame,
-            &self.hg_inv_len,
-            &self.gp_grad,
-            &self.gp_weight,
-        )
+    /// The reference data the `f64` kernels read, borrowed.
+    pub fn refs(&self) -> Refs<'_, F64x8> {
+        Refs {
+            grad: &self.grad,
+            gamma: &self.gamma,
+            hg_frame: &self.hg_frame,
+            hg_inv_len: &self.hg_inv_len,
+            gp_grad: &self.gp_grad,
+            gp_weight: &self.gp_weight,
+        }
     }
 
     /// History value `k` of integration point `ip` of group-local element `le`.

@@ -148,8 +148,8 @@ fn step_bytes_per_element(m: &solver::model::Model) -> f64 {
     for g in &m.groups {
         // An f32 run reads its reference data from the group's f32 copy.
         let reference = match g.narrow.as_deref() {
-            Some(n) => n.bytes(),
-            None => g.reference_bytes(),
+            Some(n) => n.refs().bytes(),
+            None => g.refs().bytes(),
         };
         bytes += g.conn.len() * (32 + 8 + 8)
             + reference

@@ -128,7 +128,7 @@ pub fn check(path: &Path, deck: &DeckArgs, pilot: Pilot) -> Result<(), String> {
         .groups
         .iter()
         .map(|g| {
-            let r = g.reference_bytes();
+            let r = g.refs().bytes();
             g.conn.len() * (8 * 4 + 8)
                 + r
                 + if narrow { r / 2 } else { 0 }

@@ -54,22 +54,48 @@ impl Precision {
     }
 }
 
+/// A group's reference data, borrowed, in lanes of `R` ([`F64x8`] from the group itself,
+/// [`F32x8`] from its [`NarrowRef`]): per batch, the mean gradients, hourglass vectors, element
+/// frames and inverse half-lengths of the physical form, Gauss-point gradients and weights (each
+/// empty where the group's formulation has none).
+#[derive(Clone, Copy)]
+pub struct Refs<'a, R> {
+    /// Mean gradients.
+    pub grad: &'a [Nodal<R>],
+    /// Hourglass vectors.
+    pub gamma: &'a [[[R; 8]; 4]],
+    /// Element frames of the physical hourglass form.
+    pub hg_frame: &'a [[[R; 3]; 3]],
+    /// Inverse half-lengths of the physical form.
+    pub hg_inv_len: &'a [[R; 3]],
+    /// Gauss-point gradients.
+    pub gp_grad: &'a [[Nodal<R>; 8]],
+    /// Gauss-point weights.
+    pub gp_weight: &'a [[R; 8]],
+}
+
+impl<R> Refs<'_, R> {
+    /// Bytes the kernels read from these data over one step.
+    pub fn bytes(&self) -> usize {
+        std::mem::size_of_val(self.grad)
+            + std::mem::size_of_val(self.gamma)
+            + std::mem::size_of_val(self.hg_frame)
+            + std::mem::size_of_val(self.hg_inv_len)
+            + std::mem::size_of_val(self.gp_grad)
+            + std::mem::size_of_val(self.gp_weight)
+    }
+}
+
 /// A group's reference data in `f32` lanes, built from the `f64` data the first time an `f32`
-/// run evaluates the group. Fields as in the solver's `Group`; empty where that one is.
+/// run evaluates the group.
 #[derive(Clone, Debug, Default)]
 pub struct NarrowRef {
-    /// Mean gradients, per batch.
-    pub grad: Vec<Nodal<F32x8>>,
-    /// Hourglass vectors, per batch.
-    pub gamma: Vec<[[F32x8; 8]; 4]>,
-    /// Element frames of the physical hourglass form, per batch.
-    pub hg_frame: Vec<[[F32x8; 3]; 3]>,
-    /// Inverse half-lengths of the physical form, per batch.
-    pub hg_inv_len: Vec<[F32x8; 3]>,
-    /// Gauss-point gradients, per batch.
-    pub gp_grad: Vec<[Nodal<F32x8>; 8]>,
-    /// Gauss-point weights, per batch.
-    pub gp_weight: Vec<[F32x8; 8]>,
+    grad: Vec<Nodal<F32x8>>,
+    gamma: Vec<[[F32x8; 8]; 4]>,
+    hg_frame: Vec<[[F32x8; 3]; 3]>,
+    hg_inv_len: Vec<[F32x8; 3]>,
+    gp_grad: Vec<[Nodal<F32x8>; 8]>,
+    gp_weight: Vec<[F32x8; 8]>,
 }
 
 /// Every lane of an array of lane vectors, rounded to `f32`.
@@ -77,53 +103,32 @@ fn narrow_all<const N: usize, const M: usize>(x: &[[F64x8; N]; M]) -> [[F32x8; N
     x.map(|row| row.map(F32x8::narrow))
 }
 
-/// Bytes of a group's reference data in either precision: gradients, hourglass vectors,
-/// element frames and inverse half-lengths, Gauss-point gradients and weights.
-pub fn reference_bytes<A, B, C, D, E, F>(
-    grad: &[A],
-    gamma: &[B],
-    hg_frame: &[C],
-    hg_inv_len: &[D],
-    gp_grad: &[E],
-    gp_weight: &[F],
-) -> usize {
-    std::mem::size_of_val(grad)
-        + std::mem::size_of_val(gamma)
-        + std::mem::size_of_val(hg_frame)
-        + std::mem::size_of_val(hg_inv_len)
-        + std::mem::size_of_val(gp_grad)
-        + std::mem::size_of_val(gp_weight)
-}
-
 impl NarrowRef {
-    /// Bytes of the copy (half those of the `f64` data it was made from).
-    pub fn bytes(&self) -> usize {
-        reference_bytes(
-            &self.grad,
-            &self.gamma,
-            &self.hg_frame,
-            &self.hg_inv_len,
-            &self.gp_grad,
-            &self.gp_weight,
-        )
+    /// The `f32` copy of a group's reference data.
+    pub fn new(r: &Refs<F64x8>) -> NarrowRef {
+        NarrowRef {
+            grad: r.grad.iter().map(narrow_all).collect(),
+            gamma: r.gamma.iter().map(narrow_all).collect(),
+            hg_frame: r.hg_frame.iter().map(narrow_all).collect(),
+            hg_inv_len: r.hg_inv_len.iter().map(|x| x.map(F32x8::narrow)).collect(),
+            gp_grad: r
+                .gp_grad
+                .iter()
+                .map(|g| g.map(|n| narrow_all(&n)))
+                .collect(),
+            gp_weight: r.gp_weight.iter().map(|x| x.map(F32x8::narrow)).collect(),
+        }
     }
 
-    /// The `f32` copy of a group's reference data.
-    pub fn new(
-        grad: &[Nodal<F64x8>],
-        gamma: &[[[F64x8; 8]; 4]],
-        hg_frame: &[[[F64x8; 3]; 3]],
-        hg_inv_len: &[[F64x8; 3]],
-        gp_grad: &[[Nodal<F64x8>; 8]],
-        gp_weight: &[[F64x8; 8]],
-    ) -> NarrowRef {
-        NarrowRef {
-            grad: grad.iter().map(narrow_all).collect(),
-            gamma: gamma.iter().map(narrow_all).collect(),
-            hg_frame: hg_frame.iter().map(narrow_all).collect(),
-            hg_inv_len: hg_inv_len.iter().map(|x| x.map(F32x8::narrow)).collect(),
-            gp_grad: gp_grad.iter().map(|g| g.map(|n| narrow_all(&n))).collect(),
-            gp_weight: gp_weight.iter().map(|x| x.map(F32x8::narrow)).collect(),
+    /// The copy, borrowed.
+    pub fn refs(&self) -> Refs<'_, F32x8> {
+        Refs {
+            grad: &self.grad,
+            gamma: &self.gamma,
+            hg_frame: &self.hg_frame,
+            hg_inv_len: &self.hg_inv_len,
+            gp_grad: &self.gp_grad,
+            gp_weight: &self.gp_weight,
         }
     }
 }
