@@ -94,8 +94,8 @@ fn models(dir: &Path) {
 }
 
 /// The 4 x 3 x 2 label volume of the NIfTI and raw seeds.
-fn labels() -> solver::voxel::LabelVolume {
-    let mut vol = solver::voxel::LabelVolume::new([4, 3, 2], [0.002, 0.002, 0.003], [0.0; 3]);
+fn labels() -> phantom::voxel::LabelVolume {
+    let mut vol = phantom::voxel::LabelVolume::new([4, 3, 2], [0.002, 0.002, 0.003], [0.0; 3]);
     for k in 0..2 {
         for j in 0..3 {
             for i in 0..4 {
@@ -111,7 +111,7 @@ fn nifti(dir: &Path) {
     let vol = labels();
     for name in ["labels.nii", "labels.nii.gz"] {
         let p = dir.join(name);
-        solver::voxel::write_nifti(&vol, &p).unwrap();
+        phantom::voxel::write_nifti(&vol, &p).unwrap();
         println!("{name}: {} bytes", std::fs::metadata(&p).unwrap().len());
     }
 }
@@ -122,7 +122,7 @@ fn raw_volume(dir: &Path) {
     std::fs::create_dir_all(dir).unwrap();
     let tmp = std::env::temp_dir().join(format!("palpa-fuzz-seeds-{}", std::process::id()));
     std::fs::create_dir_all(&tmp).unwrap();
-    let raw = solver::voxel::write_raw(&labels(), &tmp.join("volume.json")).unwrap();
+    let raw = phantom::voxel::write_raw(&labels(), &tmp.join("volume.json")).unwrap();
     let mut seed = std::fs::read(tmp.join("volume.json")).unwrap();
     seed.extend_from_slice(MODEL_SEPARATOR);
     seed.extend(std::fs::read(raw).unwrap());

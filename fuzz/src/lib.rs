@@ -149,7 +149,7 @@ fn scratch_file(name: &str, data: &[u8]) -> PathBuf {
 /// output plan), not run; as `palpa check` does.
 pub fn scene(data: &[u8]) {
     let Some(src) = local_toml(data) else { return };
-    let Ok(mut spec) = toml::from_str::<solver::scene::SceneSpec>(src) else {
+    let Ok(mut spec) = toml::from_str::<scene::SceneSpec>(src) else {
         return;
     };
     let limit = spec.mesh.max_elements.map_or(MAX_FUZZ_ELEMENTS, |m| m.0);
@@ -169,7 +169,7 @@ pub fn scene(data: &[u8]) {
     let path = work_dir().join("scene.toml");
     verbose(
         "scene",
-        &solver::scene::build::build_scene_with(spec, &path, src, prebuilt).map(|_| ()),
+        &scene::build::build_scene_with(spec, &path, src, prebuilt).map(|_| ()),
     );
 }
 
@@ -177,14 +177,14 @@ pub fn scene(data: &[u8]) {
 pub const FUZZ_PHANTOM_VOXEL: f64 = 0.03;
 
 /// The reduced phantom at [`FUZZ_PHANTOM_VOXEL`], built once.
-fn fuzz_phantom() -> &'static solver::phantom::Phantom {
-    static PH: OnceLock<solver::phantom::Phantom> = OnceLock::new();
+fn fuzz_phantom() -> &'static phantom::Phantom {
+    static PH: OnceLock<phantom::Phantom> = OnceLock::new();
     PH.get_or_init(|| {
-        let params = solver::phantom::PhantomParams {
+        let params = phantom::PhantomParams {
             voxel: FUZZ_PHANTOM_VOXEL,
             ..Default::default()
         };
-        solver::phantom::build(&params).expect("the fuzz phantom builds")
+        phantom::build(&params).expect("the fuzz phantom builds")
     })
 }
 
@@ -245,7 +245,7 @@ pub fn campaign(data: &[u8]) {
     let Some(src) = text(data, MAX_TEXT) else {
         return;
     };
-    let Ok(spec) = toml::from_str::<solver::campaign::CampaignSpec>(src) else {
+    let Ok(spec) = toml::from_str::<campaign::CampaignSpec>(src) else {
         return;
     };
     let r = spec.resolve();
@@ -255,7 +255,7 @@ pub fn campaign(data: &[u8]) {
     for r in c.runs.iter().take(64) {
         let _ = c.samples_per_run(r);
         let scene = c.setup(r).scene_toml();
-        if let Err(e) = toml::from_str::<solver::scene::SceneSpec>(&scene) {
+        if let Err(e) = toml::from_str::<scene::SceneSpec>(&scene) {
             panic!(
                 "run {}: the generated scene does not parse: {e}\n{scene}",
                 r.label
@@ -276,7 +276,7 @@ pub fn nifti(data: &[u8]) {
     };
     verbose(
         "nifti",
-        &solver::voxel::read_nifti(&scratch_file(name, data)),
+        &phantom::voxel::read_nifti(&scratch_file(name, data)),
     );
 }
 
@@ -465,7 +465,7 @@ pub fn stl(data: &[u8]) {
 
 /// A raw label volume: its JSON header and its raw bytes, joined by the line of
 /// [`MODEL_SEPARATOR`], written as `volume.json` and `volume.raw` and read as `palpa mesh image`
-/// reads it (`solver::voxel::read_volume`), then its label counts. The header's `data` may only
+/// reads it (`phantom::voxel::read_volume`), then its label counts. The header's `data` may only
 /// name a file of the scratch directory; an input whose `data` names another is skipped.
 pub fn raw_volume(data: &[u8]) {
     if data.len() > MAX_BINARY {
@@ -487,7 +487,7 @@ pub fn raw_volume(data: &[u8]) {
             let _ = std::fs::remove_file(&raw);
         }
     }
-    let r = solver::voxel::read_volume(&json);
+    let r = phantom::voxel::read_volume(&json);
     verbose("raw_volume", &r);
     if let Ok(v) = r {
         let _ = v.label_counts();

@@ -33,6 +33,8 @@
 //!   (stiffness cap, samples, margins) are comments only.
 
 use crate::units::Units;
+use ::scene::def::DtMin;
+use ::scene::Scene;
 use contact::tessellate::{self as shapes, HexMesh};
 use contact::{Curve, MotionSpec, PenaltyKind, ShapeSpec};
 use material::quantity::Dim;
@@ -41,8 +43,6 @@ use solver::bc::Kinematic;
 use solver::element::precision::Precision;
 use solver::element::{Formulation, HourglassForm, HourglassModulus};
 use solver::model::StepTarget;
-use solver::scene::def::DtMin;
-use solver::scene::Scene;
 use std::collections::HashMap;
 use std::fmt::Write;
 
@@ -1592,7 +1592,7 @@ fn soft_sfs(scene: &Scene, faces: &[[u32; 4]]) -> f64 {
 fn write_material(
     w: &mut W,
     pid: i64,
-    p: &solver::scene::def::PartDef,
+    p: &::scene::def::PartDef,
     notes: &mut Vec<String>,
     new_curve: &mut impl FnMut(&str, Vec<(f64, f64)>, Dim, Dim, Option<(String, String)>) -> i64,
 ) -> Result<(), String> {

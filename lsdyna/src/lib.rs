@@ -29,8 +29,8 @@ pub mod units;
 pub use scene::{DeckError, ReadOptions, Report};
 pub use units::Units;
 
-use solver::scene::def::SceneDef;
-use solver::scene::Scene;
+use ::scene::def::SceneDef;
+use ::scene::Scene;
 use std::path::Path;
 
 /// Whether a file name looks like a keyword deck (`.k`, `.key`, `.dyn`, `.kw`).
@@ -59,7 +59,7 @@ pub fn read_deck(path: &Path, opts: &ReadOptions) -> Result<(SceneDef, Report), 
 /// Read a deck and assemble it into a runnable scene.
 pub fn load_deck(path: &Path, opts: &ReadOptions) -> Result<(Scene, Report), DeckError> {
     let (def, report) = read_deck(path, opts)?;
-    let scene = solver::scene::def::assemble(def).map_err(|e| DeckError {
+    let scene = ::scene::def::assemble(def).map_err(|e| DeckError {
         errors: vec![e],
         warnings: report.warnings.clone(),
     })?;

@@ -36,6 +36,8 @@ use crate::annotate::{self, BcCurve, ElementNote, RelaxationNote, RunNote};
 use crate::keywords::{ContactCard, CurveCard, Deck, Key, MatCard, MatKind, PartCard, Target};
 use crate::lex::Loc;
 use crate::units::Units;
+use ::scene::contact_def::{ContactDef, IndenterDef, SurfaceSel};
+use ::scene::def::{DtMin, HourglassGuard, OutputPlan, PartDef, SceneDef, Setup};
 use contact::{ContactParams, Curve, IndenterSpec, MotionSpec, PenaltyKind, ShapeSpec};
 use material::quantity::{Density, Dim, Number, Pressure, Rate};
 use material::spec::{FoamSpec, IsotropicSpec, OgdenSpec, PlasticitySpec, PronySpec};
@@ -46,8 +48,6 @@ use solver::element::precision::Precision;
 use solver::element::{BulkViscosity, Formulation, Hourglass, HourglassForm, HourglassModulus};
 use solver::mesh::Mesh;
 use solver::model::{MassScaling, StepTarget};
-use solver::scene::contact_def::{ContactDef, IndenterDef, SurfaceSel};
-use solver::scene::def::{DtMin, HourglassGuard, OutputPlan, PartDef, SceneDef, Setup};
 use solver::simulation::DynamicRelaxation;
 use std::collections::{BTreeMap, HashMap, HashSet};
 use std::path::{Path, PathBuf};
@@ -1003,7 +1003,7 @@ fn build(cx: &mut Ctx, path: &Path) -> Result<SceneDef, Vec<String>> {
     bail!();
 
     // Output.
-    let mut fields: Vec<String> = solver::scene::output_plan::VTK_FIELDS
+    let mut fields: Vec<String> = ::scene::output_plan::VTK_FIELDS
         .iter()
         .map(|s| s.to_string())
         .collect();
@@ -1771,13 +1771,13 @@ fn contact_def(
                 ..ContactParams::default()
             };
             let mut t = cx.comments(&c.palpa.clone());
-            if let Some(note) = annotate::take::<solver::scene::contact_spec::ContactScene>(
+            if let Some(note) = annotate::take::<::scene::contact_spec::ContactScene>(
                 &mut t,
                 "contact",
                 &c.at,
                 &mut cx.warn,
             ) {
-                match solver::contact_stage::contact_params(Some(&note), 0.0) {
+                match ::scene::contact_build::contact_params(Some(&note), 0.0) {
                     Ok(mut q) if c.soft == 1 && q.soft_scale == c.sofscl => {
                         q.design_dt = note.design_dt.map(|t| t.0);
                         q.friction = p.friction;

@@ -13,9 +13,9 @@
 //!   faceted one is softer at the smallest depth, where the contact radius spans two facets).
 
 use lsdyna::{load_deck, ReadOptions, Units};
+use scene::run::run_scene;
+use scene::{load_scene, Scene};
 use solver::output::history::{column, read_history};
-use solver::run::run_scene;
-use solver::scene::{load_scene, Scene};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::AtomicBool;
 

@@ -6,8 +6,8 @@
 
 use lsdyna::export::{export, ExportOptions};
 use lsdyna::{load_deck, ReadOptions};
-use solver::run::run_scene;
-use solver::scene::{load_scene, Scene};
+use scene::run::run_scene;
+use scene::{load_scene, Scene};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::AtomicBool;
 

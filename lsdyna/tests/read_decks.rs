@@ -280,7 +280,7 @@ fn parameters_read_as_their_values() {
         .0;
     assert_eq!(d.end_time, base.end_time);
     assert_eq!(d.mesh.nodes, base.mesh.nodes);
-    let show = |s: &solver::scene::def::SceneDef| format!("{:?}", s.setup.parts[0].spec);
+    let show = |s: &scene::def::SceneDef| format!("{:?}", s.setup.parts[0].spec);
     assert_eq!(show(&d), show(&base));
     let undefined = with.replace("    1.0e-6    &YOUNG", "    1.0e-6   &YOUNGS");
     let e = fails(&write(dir.path(), "undef.k", &undefined), &kg_mm_ms())

@@ -4,7 +4,7 @@
 
 use lsdyna::export::{export, ExportOptions};
 use lsdyna::{load_deck, ReadOptions};
-use solver::scene::{load_scene, Scene};
+use scene::{load_scene, Scene};
 use std::path::Path;
 
 fn roundtrip(scene: &Scene, units: &str) -> Scene {
@@ -54,7 +54,7 @@ fn same(a: &Scene, b: &Scene) {
             None => s,
         }
     };
-    let parts = |s: &solver::scene::def::Setup| -> Vec<String> {
+    let parts = |s: &scene::def::Setup| -> Vec<String> {
         s.parts
             .iter()
             .map(|p| strip_id(format!("{} {:?} {:?}", p.name, p.material, p.formulation)))
@@ -140,7 +140,7 @@ fn compression_block_and_finger_press_round_trip_exactly() {
 #[test]
 fn palpation_round_trips_exactly() {
     let dir = tempfile::tempdir().unwrap();
-    let setup = solver::palpation::PalpationSetup {
+    let setup = scene::palpation::PalpationSetup {
         voxel: 0.008,
         depth: 0.004,
         duration: 0.004,
@@ -162,14 +162,14 @@ fn palpation_round_trips_exactly() {
 #[test]
 fn the_fast_preset_round_trips_exactly() {
     let dir = tempfile::tempdir().unwrap();
-    let mut setup = solver::palpation::PalpationSetup {
+    let mut setup = scene::palpation::PalpationSetup {
         voxel: 0.008,
         depth: 0.004,
         duration: 0.004,
         sample_interval: 0.001,
         ..Default::default()
     };
-    solver::palpation::Fidelity::Fast.apply(&mut setup);
+    scene::palpation::Fidelity::Fast.apply(&mut setup);
     let path = dir.path().join("scene.toml");
     std::fs::write(&path, setup.scene_toml()).unwrap();
     let a = load_scene(&path).unwrap();

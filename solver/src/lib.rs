@@ -1,9 +1,10 @@
-//! palpa's explicit solver: hexahedral meshes, total-Lagrangian elements, the central-difference
-//! time loop, scenes, and output.
+//! palpa's explicit core: hexahedral meshes and their files, total-Lagrangian elements, the
+//! model, the element-force loop, the central-difference time loop with its force stages
+//! (contact among them), boundary conditions, and output. Scenes (the `scene` crate), the phantom
+//! (`phantom`) and campaigns (`campaign`) build on it; it depends on none of them.
 #![warn(missing_docs)]
 
 pub mod bc;
-pub mod campaign;
 pub mod contact_stage;
 pub mod element;
 pub mod forces;
@@ -13,12 +14,7 @@ pub mod mesh;
 pub mod mesh_io;
 pub mod model;
 pub mod output;
-pub mod palpation;
-pub mod phantom;
-pub mod run;
-pub mod scene;
 pub mod simulation;
-pub mod voxel;
 
 pub use mesh::Mesh;
 pub use model::{Model, Part, SolverError};

@@ -10,7 +10,6 @@
 //! bL = 1.87510, s = (cosh bL + cos bL)/(sinh bL + sin bL). The first period
 //! T = 2 pi / ((bL)^2 sqrt(E I / (rho A L^4))) must be matched within 3 %.
 
-mod common;
 use contact::Curve;
 use material::linear_elastic::{Kinematics, LinearElastic};
 use material::Material;

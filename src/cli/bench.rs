@@ -26,9 +26,9 @@
 //! that roof the case reaches. The bytes are a count of the arrays the step touches, not a
 //! hardware measurement: cache reuse of the gathered nodal data can beat the roof.
 
+use scene::build::build_scene;
+use scene::SceneSpec;
 use solver::element::precision::Precision;
-use solver::scene::build::build_scene;
-use solver::scene::SceneSpec;
 use std::path::Path;
 use std::time::Instant;
 

@@ -1,4 +1,4 @@
-//! `palpa campaign [CAMPAIGN.toml] --out DIR`: run a palpation campaign ([`solver::campaign`])
+//! `palpa campaign [CAMPAIGN.toml] --out DIR`: run a palpation campaign ([`campaign`])
 //! and write the surrogate's training dataset; `palpa campaign merge DIR... --out DIR` joins
 //! the shards of a campaign.
 //!
@@ -26,15 +26,15 @@
 //! cores split between the jobs when there are fewer runs left than cores.
 
 use super::progress::{stop_flag, time_bar};
-use ndarray::{Array1, Array2, Array3};
-use serde_json::{json, Value};
-use solver::campaign::{
+use campaign::{
     in_shard, parse_shard, read_done, read_run, run_dir, write_done, Campaign, CampaignSpec,
     DoneMarker, PlannedRun, CAMPAIGN_FILE, CAMPAIGN_FORMAT, DONE_FILE,
 };
+use ndarray::{Array1, Array2, Array3};
+use phantom::Phantom;
+use scene::run::run_scene;
+use serde_json::{json, Value};
 use solver::output::atomic::write_atomic;
-use solver::phantom::Phantom;
-use solver::run::run_scene;
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::Mutex;
@@ -311,8 +311,7 @@ fn run_campaign(a: &CampaignArgs) -> Result<(), String> {
     // The phantom, once for every run.
     let t0 = Instant::now();
     let params = campaign.phantom_params().map_err(in_file)?;
-    let phantom =
-        solver::phantom::build(&params).map_err(|e| in_file(format!("[phantom]: {e}")))?;
+    let phantom = phantom::build(&params).map_err(|e| in_file(format!("[phantom]: {e}")))?;
     let build_s = t0.elapsed().as_secs_f64();
     let locs = campaign.resolve_locations(&phantom)?;
     let plan = campaign.plan_json(&phantom, &locs);
@@ -469,12 +468,7 @@ fn run_campaign(a: &CampaignArgs) -> Result<(), String> {
     Ok(())
 }
 
-fn print_plan(
-    c: &Campaign,
-    locs: &[solver::phantom::Location],
-    mine: &[&PlannedRun],
-    done: &[bool],
-) {
+fn print_plan(c: &Campaign, locs: &[phantom::Location], mine: &[&PlannedRun], done: &[bool]) {
     println!(
         "  {:<20} {:<8} {:<5} {:>8} {:>8} {:>8} {:>8} {:>9} {:>7}  state",
         "run", "location", "split", "x mm", "y mm", "liver mm", "depth mm", "time ms", "samples"

@@ -7,7 +7,7 @@ use solver::hex::corner_jacobians;
 use std::path::Path;
 
 /// When `check` runs the pilot that follows the step as elements shrink
-/// ([`solver::scene::pilot`]).
+/// ([`scene::pilot`]).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Pilot {
     /// Whatever it costs (`--pilot`).
@@ -103,12 +103,8 @@ pub fn check(path: &Path, deck: &DeckArgs, pilot: Pilot) -> Result<(), String> {
         println!("  mass scaling: none");
     }
     let dt_max = sim.settings.dt_max;
-    let steps = solver::scene::def::estimated_steps(
-        m,
-        f,
-        dt_max.is_finite().then_some(dt_max),
-        scene.end_time,
-    );
+    let steps =
+        scene::def::estimated_steps(m, f, dt_max.is_finite().then_some(dt_max), scene.end_time);
     let capped = dt_max.is_finite() && dt_max < f * dt0;
     println!(
         "  estimated steps at the starting step: {:.0} ({:.3e} element-cycles) for end time {:.4} ms{}",
@@ -166,14 +162,8 @@ pub fn check(path: &Path, deck: &DeckArgs, pilot: Pilot) -> Result<(), String> {
 }
 
 /// Run the pilot when asked or cheap and print its estimate, or why there is none.
-fn print_pilot(
-    path: &Path,
-    scene: &solver::scene::Scene,
-    pilot: Pilot,
-    deck: bool,
-    elements: usize,
-) {
-    use solver::scene::pilot::{self, PilotPlan, PILOT_BULK_RATIO};
+fn print_pilot(path: &Path, scene: &scene::Scene, pilot: Pilot, deck: bool, elements: usize) {
+    use scene::pilot::{self, PilotPlan, PILOT_BULK_RATIO};
     let why_not = |why: &str| {
         println!("  pilot: none ({why}); a run may take more steps than the starting step gives when elements shrink under load");
     };

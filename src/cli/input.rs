@@ -1,7 +1,7 @@
 //! Loading what `palpa run` and `palpa check` are given: a TOML scene, or an LS-DYNA keyword
 //! deck (`.k`, `.key`, `.dyn`) read by the `lsdyna` crate with the unit system the user states.
 
-use solver::scene::{load_scene, Scene};
+use scene::{load_scene, Scene};
 use std::path::Path;
 
 /// How to read a keyword deck (ignored for a TOML scene).

@@ -7,11 +7,11 @@
 
 use clap::{Args, Subcommand};
 use material::quantity::{Dim, Quantity};
+use phantom::voxel::{self, LabelMap, LabelVolume, MeshOptions, MeshQuality};
+use phantom::{self, PhantomParams, Tumour, Variant};
 use solver::mesh::Mesh;
 use solver::output::atomic::write_atomic;
 use solver::output::vtk::{write_vtu, Frame};
-use solver::phantom::{self, PhantomParams, Tumour, Variant};
-use solver::voxel::{self, LabelMap, LabelVolume, MeshOptions, MeshQuality};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 

@@ -1,5 +1,5 @@
 //! `palpa palpate`: the main job. Builds the reduced abdomen phantom, presses the two-finger
-//! hand into it with the paper's materials and protocol ([`solver::palpation`]), and writes
+//! hand into it with the paper's materials and protocol ([`scene::palpation`]), and writes
 //! into `--out`:
 //! - `scene.toml`: the scene that was run (`palpa run` repeats it);
 //! - `frame_*.vtu` + `frame.pvd` (ParaView), `history.csv`, `summary.json`;
@@ -12,10 +12,10 @@
 
 use super::run::{print_summary, run_loaded};
 use super::units;
+use scene::load_scene;
+use scene::palpation::{read_probe, ElementChoice, Fidelity, PalpationSetup, Place, ProbeSamples};
 use solver::output::atomic::write_atomic;
 use solver::output::history::{column, read_history};
-use solver::palpation::{read_probe, ElementChoice, Fidelity, PalpationSetup, Place, ProbeSamples};
-use solver::scene::load_scene;
 use std::fmt::Write;
 use std::path::Path;
 use std::time::Instant;
@@ -114,7 +114,7 @@ impl PalpateArgs {
         s.duration = units::time(&self.duration, "--duration")?;
         s.sample_interval = units::time(&self.sample_interval, "--sample-interval")?;
         if self.paper {
-            s.voxel = solver::phantom::PAPER_VOXEL;
+            s.voxel = phantom::PAPER_VOXEL;
         }
         if let Some(v) = &self.voxel {
             s.voxel = units::length(v, "--voxel")?;

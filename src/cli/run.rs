@@ -3,8 +3,8 @@
 
 use super::input::{load, print_report, DeckArgs};
 use super::progress::{stop_flag, time_bar};
-use solver::run::{run_scene, RunSummary};
-use solver::scene::Scene;
+use scene::run::{run_scene, RunSummary};
+use scene::Scene;
 use std::path::Path;
 use std::time::Instant;
 

@@ -1,5 +1,5 @@
 //! The plan-view geometry of a model ([`surrogate::ViewGeometry`], `view.json`) from the
-//! phantom it was trained on: outlines from [`solver::phantom::plan_view`], ROI cells as the
+//! phantom it was trained on: outlines from [`phantom::plan_view`], ROI cells as the
 //! convex hulls of the ROI elements' nodes in plan ([`surrogate::view::convex_hull`]), the
 //! hand from the campaign's finger settings.
 //!
@@ -8,8 +8,8 @@
 //! committed default campaign), rebuilds the phantom from the manifest's `phantom.parameters`
 //! (a few seconds) and checks that its ROI is the dataset's, element for element.
 
+use phantom::{plan_view, Phantom, PLAN_STEP};
 use solver::mesh::Mesh;
-use solver::phantom::{plan_view, Phantom, PLAN_STEP};
 use std::path::{Path, PathBuf};
 use surrogate::view::{convex_hull, Fingers, ViewGeometry, VIEW_FORMAT, VIEW_VERSION};
 
@@ -94,9 +94,9 @@ pub fn for_dataset(dataset: &Path) -> Result<Option<ViewGeometry>, String> {
         let v: Vec<f64> = a.iter().filter_map(|x| x.as_f64()).collect();
         (v.len() == 3).then(|| [v[0], v[1], v[2]])
     });
-    let p = solver::campaign::phantom_params_from_json(params, centre)
+    let p = campaign::phantom_params_from_json(params, centre)
         .map_err(|e| format!("{}: manifest: {e}", dataset.display()))?;
-    let ph = solver::phantom::build(&p)
+    let ph = phantom::build(&p)
         .map_err(|e| format!("{}: rebuilding its phantom: {e}", dataset.display()))?;
     let ids: Vec<i64> = ph.roi.elements.iter().map(|&e| e as i64).collect();
     if ids.as_slice() != data.roi_ids.as_slice().unwrap_or(&[]) {

@@ -438,10 +438,10 @@ pub fn run_contact_scene(scene: &str, tag: &str, name: &str) -> Result<SceneRun,
     let path = dir.join("scene.toml");
     std::fs::write(&path, scene).map_err(|e| e.to_string())?;
     let result = (|| {
-        let mut sc = solver::scene::load_scene(&path)?;
+        let mut sc = scene::load_scene(&path)?;
         let stop = std::sync::atomic::AtomicBool::new(false);
         let out = dir.join("out");
-        let (summary, err) = solver::run::run_scene(&mut sc, &out, &stop, |_| {});
+        let (summary, err) = scene::run::run_scene(&mut sc, &out, &stop, |_| {});
         if let Some(e) = err {
             return Err(e);
         }

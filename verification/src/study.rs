@@ -1,7 +1,7 @@
 //! Accuracy against cost: `palpa study`.
 //!
 //! Every knob that trades accuracy for speed is measured both ways on the palpation of the
-//! abdomen phantom ([`solver::palpation`]): the mesh size (voxel edge), the element formulation,
+//! abdomen phantom ([`scene::palpation`]): the mesh size (voxel edge), the element formulation,
 //! selective mass scaling (targets of 1, 2, 4 and 10 times the initial stable step; 1 is
 //! palpate's default, which adds mass only to elements that shrink during the run), the bulk
 //! modulus cap (K/G 5e3, 1e3, 5e2 against the laws' own 5e4) and the time-step factor. Each setting changes one knob of a base setting (one-point elements with
@@ -28,13 +28,13 @@
 //! `--quick` uses a coarse phantom and a short indentation (6 mm in 6 ms) so that it finishes
 //! in a few minutes on two cores; the full study runs the paper's 15 mm in 25 ms.
 
+use phantom::Phantom;
+use scene::build::load_scene_with;
+use scene::palpation::{read_probe, ElementChoice, PalpationSetup, ProbeSamples};
+use scene::run::{run_scene, RunSummary};
 use solver::model::StepTarget;
 use solver::output::filter::{moving_average, moving_average_at, FORCE_FILTER};
 use solver::output::history::{column, read_history};
-use solver::palpation::{read_probe, ElementChoice, PalpationSetup, ProbeSamples};
-use solver::phantom::Phantom;
-use solver::run::{run_scene, RunSummary};
-use solver::scene::build::load_scene_with;
 use std::collections::HashMap;
 use std::fmt::Write;
 use std::path::{Path, PathBuf};
@@ -168,7 +168,7 @@ fn run_one(
     std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
     let key = setup.voxel.to_bits();
     if !phantoms.contains_key(&key) {
-        let p = solver::phantom::build(&setup.phantom_params()?)?;
+        let p = phantom::build(&setup.phantom_params()?)?;
         phantoms.insert(key, p);
     }
     let scene_path = dir.join("scene.toml");

@@ -1,0 +1,501 @@
+//! One two-finger palpation of the abdomen phantom, as the reference study ran it
+//! (`docs/paper.md`): the reduced phantom, the paper's three tissues
+//! (`paper:liver`, `paper:flesh`, `paper:ribs`), two rigid capsule fingers pressed 15 mm along
+//! the inward skin normal in 25 ms with a smooth ramp, penalty contact on the anterior skin,
+//! the back fixed and rollers on the cut planes, and the ROI's stresses sampled every 5 ms.
+//!
+//! [`PalpationSetup::scene_toml`] writes this as an ordinary scene file, so that a palpation is
+//! a scene like any other: `palpa palpate` saves it as `scene.toml` in its output directory,
+//! and `palpa run` on that file repeats the run exactly. Campaigns and the accuracy study
+//! vary its fields. [`read_probe`] reads the ROI samples back.
+//!
+//! Materials of the other phantom parts: the lumped viscera are given the flesh law (the
+//! paper's "lumped abdominal tissue"), the spine the rib law (its nodes are fixed anyway), and
+//! a tumour the liver law with its shear and Prony moduli scaled by the tumour's stiffness
+//! factor (so its Poisson ratio and relaxation times stay the liver's).
+
+use phantom::DEFAULT_VOXEL;
+use solver::element::{HourglassForm, HourglassModulus};
+use solver::model::StepTarget;
+use solver::output::history::{column, read_history};
+use std::fmt::Write;
+use std::path::Path;
+
+/// Where the fingers press.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Place {
+    /// A named phantom location: "A", "B", "C", "P01".."P25".
+    Named(String),
+    /// A point (x, y) of the body surface (m).
+    At(f64, f64),
+}
+
+/// Element formulation of every part.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum ElementChoice {
+    /// One-point integration with viscous hourglass control scaled by the P-wave modulus
+    /// (LS-DYNA's type 1).
+    OnePointViscous,
+    /// One-point integration with stiffness hourglass control scaled by the P-wave modulus
+    /// (Flanagan-Belytschko, LS-DYNA type 4).
+    OnePointStiffness,
+    /// One-point integration with viscous hourglass control scaled by the shear modulus.
+    OnePointViscousShear,
+    /// One-point integration with stiffness hourglass control scaled by the shear modulus
+    /// (in the spirit of LS-DYNA type 6).
+    OnePointStiffnessShear,
+    /// One-point integration with physical (assumed-strain) hourglass stabilisation, Q = 1
+    /// (in the spirit of LS-DYNA type 6, see [`solver::element::physical`]).
+    OnePointPhysical,
+    /// Fully integrated 2x2x2 with F-bar.
+    FullFbar,
+}
+
+impl ElementChoice {
+    /// Every choice, in table order.
+    pub const ALL: [ElementChoice; 6] = [
+        ElementChoice::OnePointViscous,
+        ElementChoice::OnePointStiffness,
+        ElementChoice::OnePointViscousShear,
+        ElementChoice::OnePointStiffnessShear,
+        ElementChoice::OnePointPhysical,
+        ElementChoice::FullFbar,
+    ];
+    /// The hourglass control of a one-point choice; `None` for F-bar.
+    pub fn hourglass(&self) -> Option<(HourglassForm, HourglassModulus)> {
+        use HourglassForm::{Physical, Stiffness, Viscous};
+        use HourglassModulus::{PWave, Shear};
+        match self {
+            ElementChoice::OnePointViscous => Some((Viscous, PWave)),
+            ElementChoice::OnePointStiffness => Some((Stiffness, PWave)),
+            ElementChoice::OnePointViscousShear => Some((Viscous, Shear)),
+            ElementChoice::OnePointStiffnessShear => Some((Stiffness, Shear)),
+            ElementChoice::OnePointPhysical => Some((Physical, Shear)),
+            ElementChoice::FullFbar => None,
+        }
+    }
+    /// Scene keys of the choice.
+    fn scene_keys(&self) -> String {
+        match self.hourglass() {
+            None => "formulation = \"full_fbar\"".into(),
+            Some((HourglassForm::Physical, _)) => {
+                "formulation = \"one_point\", hourglass = \"physical\", hourglass_coefficient = 1.0"
+                    .into()
+            }
+            Some((form, modulus)) => format!(
+                "formulation = \"one_point\", hourglass = \"{}\", hourglass_modulus = \"{}\"",
+                match form {
+                    HourglassForm::Viscous => "viscous",
+                    _ => "stiffness",
+                },
+                match modulus {
+                    HourglassModulus::PWave => "p_wave",
+                    HourglassModulus::Shear => "shear",
+                }
+            ),
+        }
+    }
+    /// Short name for tables.
+    pub fn label(&self) -> &'static str {
+        match self {
+            ElementChoice::OnePointViscous => "1pt-viscous",
+            ElementChoice::OnePointStiffness => "1pt-stiffness",
+            ElementChoice::OnePointViscousShear => "1pt-viscous-shear",
+            ElementChoice::OnePointStiffnessShear => "1pt-stiffness-shear",
+            ElementChoice::OnePointPhysical => "1pt-physical",
+            ElementChoice::FullFbar => "full-fbar",
+        }
+    }
+}
+
+impl std::str::FromStr for ElementChoice {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s {
+            "1pt-viscous" | "viscous" => Ok(ElementChoice::OnePointViscous),
+            "one_point" => Ok(ElementChoice::OnePointViscousShear),
+            "1pt-stiffness" | "stiffness" => Ok(ElementChoice::OnePointStiffness),
+            "1pt-viscous-shear" | "viscous-shear" => Ok(ElementChoice::OnePointViscousShear),
+            "1pt-stiffness-shear" | "stiffness-shear" => Ok(ElementChoice::OnePointStiffnessShear),
+            "1pt-physical" | "physical" => Ok(ElementChoice::OnePointPhysical),
+            "full_fbar" | "full-fbar" | "full" => Ok(ElementChoice::FullFbar),
+            o => Err(format!(
+                "unknown element formulation `{o}` (one_point, 1pt-viscous, 1pt-stiffness, \
+                 1pt-viscous-shear, 1pt-stiffness-shear, 1pt-physical, full_fbar)"
+            )),
+        }
+    }
+}
+
+/// A named setting of the knobs that trade accuracy for time (`--fidelity` of `palpate`,
+/// `solver.fidelity` of a campaign). Measured on the 5 mm phantom at location A against
+/// fully integrated F-bar elements at the laws' own bulk modulus (docs/palpate.md, section
+/// "Element and incompressibility").
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Fidelity {
+    /// The options as given (by default: one-point elements with shear-scaled viscous
+    /// hourglass control, the laws' own bulk moduli).
+    Standard,
+    /// One-point elements with physical hourglass stabilisation, every part's bulk modulus
+    /// capped at 5000 times its shear modulus, and single-precision element kernels.
+    Fast,
+}
+
+impl Fidelity {
+    /// The K/G cap of the fast preset.
+    pub const FAST_BULK_RATIO: f64 = 5000.0;
+    /// Apply the preset to a setup.
+    pub fn apply(&self, s: &mut PalpationSetup) {
+        if *self == Fidelity::Fast {
+            s.element = ElementChoice::OnePointPhysical;
+            s.part_elements.clear();
+            s.max_bulk_ratio = Some(Self::FAST_BULK_RATIO);
+            s.precision = solver::element::precision::Precision::F32;
+        }
+    }
+    /// The preset and its measured error budget, for the summary.
+    pub fn describe(&self) -> &'static str {
+        match self {
+            Fidelity::Standard => "standard (the options as given)",
+            Fidelity::Fast => {
+                "fast (1pt-physical, K/G <= 5000, f32 kernels): measured at 5 mm, location A, against F-bar at full K \
+                 in f64: hand force within 10 % (-4 .. -10 % at 10-24.5 ms), ROI stress Fit 0.88 (0.79-0.91 per sample), \
+                 3.2x fewer steps; f32 alone moves the 1 ms hand force by at most 0.7 % and keeps ROI Fit 0.9995; \
+                 the standard default: force -12 .. -23 %, Fit 0.65"
+            }
+        }
+    }
+}
+
+impl std::str::FromStr for Fidelity {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s {
+            "standard" => Ok(Fidelity::Standard),
+            "fast" => Ok(Fidelity::Fast),
+            o => Err(format!("unknown fidelity `{o}` (standard, fast)")),
+        }
+    }
+}
+
+/// A liver tumour (SI).
+#[derive(Clone, Debug, PartialEq)]
+pub struct TumourSetup {
+    /// Centre (m).
+    pub center: [f64; 3],
+    /// Radius (m).
+    pub radius: f64,
+    /// Stiffness relative to healthy liver.
+    pub stiffness: f64,
+}
+
+/// Everything that defines one palpation. Lengths in m, times in s.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PalpationSetup {
+    /// Title of the run.
+    pub title: String,
+    /// `reduced` or `full`.
+    pub variant: String,
+    /// Voxel edge (m).
+    pub voxel: f64,
+    /// Subcutaneous fat (m).
+    pub fat_thickness: f64,
+    /// Respiratory phase 0..1.
+    pub respiratory_phase: f64,
+    /// Tumours.
+    pub tumours: Vec<TumourSetup>,
+    /// Where the fingers press.
+    pub place: Place,
+    /// Indentation depth (m).
+    pub depth: f64,
+    /// Time to reach the depth (s); the run ends then.
+    pub duration: f64,
+    /// Interval between stress samples and VTK frames (s).
+    pub sample_interval: f64,
+    /// Finger diameter (m).
+    pub finger_diameter: f64,
+    /// Centre-to-centre finger spacing (m).
+    pub finger_spacing: f64,
+    /// Element formulation.
+    pub element: ElementChoice,
+    /// Per-part formulations that replace `element` (part name to choice): e.g. F-bar in the
+    /// liver, whose element stresses are the ROI's, and one-point elsewhere. Tumour parts
+    /// follow the liver's entry unless they have their own.
+    pub part_elements: std::collections::BTreeMap<String, ElementChoice>,
+    /// Selective mass scaling, if any. Default: the initial stable step
+    /// ([`StepTarget::Initial`]), so that elements crushed under the fingers do not pull
+    /// the step down (about half the steps of an unscaled run, about 1.4 % mass added to the
+    /// flesh at the default resolution); `None` runs without.
+    pub mass_scaling: Option<StepTarget>,
+    /// Largest mass that mass scaling may add, as a fraction of the physical mass.
+    pub mass_scaling_limit: f64,
+    /// Time-step safety factor.
+    pub dt_factor: f64,
+    /// The incompressibility knob: cap every part's bulk modulus at this multiple of its
+    /// initial shear modulus (`max_bulk_ratio` of each `[[part]]`); `None` keeps the laws'.
+    pub max_bulk_ratio: Option<f64>,
+    /// The preset the knobs came from (stated in the summary).
+    pub fidelity: Fidelity,
+    /// The element kernels' number type (`[run] precision`).
+    pub precision: solver::element::precision::Precision,
+    /// Write VTK frames.
+    pub vtk: bool,
+}
+
+impl Default for PalpationSetup {
+    /// The paper's protocol on the default (coarse) reduced phantom at location A.
+    fn default() -> Self {
+        PalpationSetup {
+            title: "palpation".into(),
+            variant: "reduced".into(),
+            voxel: DEFAULT_VOXEL,
+            fat_thickness: 0.015,
+            respiratory_phase: 0.0,
+            tumours: Vec::new(),
+            place: Place::Named("A".into()),
+            depth: 0.015,
+            duration: 0.025,
+            sample_interval: 0.005,
+            finger_diameter: 0.015,
+            finger_spacing: 0.020,
+            element: ElementChoice::OnePointViscousShear,
+            part_elements: Default::default(),
+            mass_scaling: Some(StepTarget::Initial(1.0)),
+            mass_scaling_limit: 0.05,
+            dt_factor: solver::simulation::DEFAULT_DT_FACTOR,
+            max_bulk_ratio: None,
+            fidelity: Fidelity::Standard,
+            precision: Default::default(),
+            vtk: true,
+        }
+    }
+}
+
+/// The liver card in SI with its moduli scaled by `s` (see the module doc).
+fn scaled_liver_card(s: f64) -> String {
+    let mu = [89.14, 9.965, -92.75].map(|m| m * s);
+    let g = [6970.1, 58327.0, 35291.0].map(|m| m * s);
+    format!(
+        "law = \"ogden\"\ndensity = \"1050 kg/m^3\"\nmu = [\"{} Pa\", \"{} Pa\", \"{} Pa\"]\n\
+         alpha = [1.0, 19.0656, -10.9604]\npoisson_ratio = 0.49\nprony = [\n  \
+         {{ modulus = \"{} Pa\", tau = \"10 ms\" }},\n  {{ modulus = \"{} Pa\", tau = \"100 ms\" }},\n  \
+         {{ modulus = \"{} Pa\", tau = \"1000 ms\" }},\n]\nprony_on = \"green_lagrange\"\n",
+        mu[0], mu[1], mu[2], g[0], g[1], g[2]
+    )
+}
+
+impl PalpationSetup {
+    /// Check the values a user can set.
+    pub fn validate(&self) -> Result<(), String> {
+        let pos = |v: f64, what: &str| {
+            if v > 0.0 && v.is_finite() {
+                Ok(())
+            } else {
+                Err(format!("{what} must be positive, got {v}"))
+            }
+        };
+        pos(self.depth, "depth")?;
+        pos(self.duration, "duration")?;
+        pos(self.sample_interval, "sample interval")?;
+        pos(self.finger_diameter, "finger diameter")?;
+        pos(self.finger_spacing, "finger spacing")?;
+        pos(self.voxel, "voxel")?;
+        if self.finger_spacing < self.finger_diameter {
+            return Err(
+                "the finger spacing (centre to centre) must be at least the diameter".into(),
+            );
+        }
+        if !(self.dt_factor > 0.0 && self.dt_factor <= 1.0) {
+            return Err(format!(
+                "dt factor must lie in (0, 1], got {}",
+                self.dt_factor
+            ));
+        }
+        if let Some(r) = self.max_bulk_ratio {
+            if r.is_nan() || r.is_infinite() || r <= 2.0 / 3.0 {
+                return Err(format!(
+                    "max bulk ratio must be a finite K/G above 2/3 (Poisson ratio above 0), got {r}"
+                ));
+            }
+        }
+        match self.mass_scaling {
+            Some(StepTarget::Step(t)) => pos(t, "mass-scaling target step")?,
+            Some(StepTarget::Initial(k)) => pos(k, "mass-scaling multiple of the initial step")?,
+            None => {}
+        }
+        Ok(())
+    }
+
+    /// The phantom parameters its scene asks for (to build the phantom once and share it, see
+    /// [`crate::build::build_scene_with`]).
+    pub fn phantom_params(&self) -> Result<phantom::PhantomParams, String> {
+        use material::quantity::{Length, Number};
+        crate::phantom_spec::PhantomScene {
+            variant: Some(self.variant.clone()),
+            voxel: Some(Length(self.voxel)),
+            fat_thickness: Some(Length(self.fat_thickness)),
+            respiratory_phase: Some(Number(self.respiratory_phase)),
+            tumours: self
+                .tumours
+                .iter()
+                .map(|t| crate::phantom_spec::TumourScene {
+                    center: t.center.map(Length),
+                    radius: Length(t.radius),
+                    stiffness: Number(t.stiffness),
+                })
+                .collect(),
+            ..Default::default()
+        }
+        .to_params()
+    }
+
+    /// The scene file text. Every quantity is written in SI with its unit.
+    pub fn scene_toml(&self) -> String {
+        let mut s = String::new();
+        let _ = writeln!(
+            s,
+            "# A two-finger palpation of the built-in abdomen phantom, written by palpa.\n\
+             # Run it again with `palpa run scene.toml --out DIR`.\n"
+        );
+        let _ = writeln!(
+            s,
+            "[run]\ntitle = {:?}\nend_time = \"{} s\"\ndt_factor = {}\nprecision = {:?}\n",
+            self.title,
+            self.duration,
+            self.dt_factor,
+            self.precision.label()
+        );
+        let _ = writeln!(
+            s,
+            "[mesh]\ngenerator = \"phantom\"\n\n[mesh.phantom]\nvariant = {:?}\nvoxel = \"{} m\"\n\
+             fat_thickness = \"{} m\"\nrespiratory_phase = {}",
+            self.variant, self.voxel, self.fat_thickness, self.respiratory_phase
+        );
+        if !self.tumours.is_empty() {
+            s.push_str("tumours = [\n");
+            for t in &self.tumours {
+                let _ = writeln!(
+                    s,
+                    "  {{ center = [\"{} m\", \"{} m\", \"{} m\"], radius = \"{} m\", stiffness = {} }},",
+                    t.center[0], t.center[1], t.center[2], t.radius, t.stiffness
+                );
+            }
+            s.push_str("]\n");
+        }
+        s.push('\n');
+        let el = |part: &str| {
+            let tumour = phantom::is_tumour_part(part);
+            let keys = self
+                .part_elements
+                .get(part)
+                .or_else(|| tumour.then(|| self.part_elements.get("liver")).flatten())
+                .unwrap_or(&self.element)
+                .scene_keys()
+                .replace(", ", "\n");
+            match self.max_bulk_ratio {
+                Some(r) => format!("{keys}\nmax_bulk_ratio = {r:?}"),
+                None => keys,
+            }
+        };
+        let parts = [
+            ("flesh", "paper:flesh"),
+            ("liver", "paper:liver"),
+            ("ribs", "paper:ribs"),
+            ("viscera", "paper:flesh"),
+            ("spine", "paper:ribs"),
+        ];
+        let tumour_names: Vec<String> = (0..self.tumours.len())
+            .map(phantom::tumour_part_name)
+            .collect();
+        for (n, t) in tumour_names.iter().zip(&self.tumours) {
+            let _ = writeln!(s, "[materials.{n}]\n{}", scaled_liver_card(t.stiffness));
+        }
+        for (p, m) in &parts {
+            let _ = writeln!(s, "[[part]]\nname = {p:?}\nmaterial = {m:?}\n{}\n", el(p));
+        }
+        for n in &tumour_names {
+            let _ = writeln!(s, "[[part]]\nname = {n:?}\nmaterial = {n:?}\n{}\n", el(n));
+        }
+        s.push_str("[[boundary]]\nnodes = \"back\"\nfix = [\"all\"]\n\n");
+        let rollers: &[(&str, &str)] = if self.variant == "full" {
+            &[("cut_ymin", "y"), ("cut_ymax", "y")]
+        } else {
+            &[("cut_xmax", "x"), ("cut_ymin", "y"), ("cut_ymax", "y")]
+        };
+        for (set, ax) in rollers {
+            let _ = writeln!(s, "[[boundary]]\nnodes = {set:?}\nfix = [{ax:?}]\n");
+        }
+        if let Some(t) = self.mass_scaling {
+            let _ = writeln!(
+                s,
+                "[mass_scaling]\ntarget_dt = \"{t}\"\nmax_added = {}\n",
+                self.mass_scaling_limit
+            );
+        }
+        let place = match &self.place {
+            Place::Named(n) => format!("location = {n:?}"),
+            Place::At(x, y) => format!("at = [\"{x} m\", \"{y} m\"]"),
+        };
+        let _ = writeln!(
+            s,
+            "[[hand]]\nname = \"hand\"\n{place}\ndiameter = \"{} m\"\nspacing = \"{} m\"\n\
+             length = \"0.06 m\"\nmotion = {{ kind = \"displacement\", curve = {{ kind = \"smooth_step\", \
+             value = \"{} m\", end = \"{} s\" }} }}\n",
+            self.finger_diameter, self.finger_spacing, self.depth, self.duration
+        );
+        s.push_str("[contact]\nsurface = \"skin\"\n\n");
+        let _ = writeln!(
+            s,
+            "[output]\ninterval = \"{} s\"\nvtk = {}\nfields = [\"displacement\", \"part\", \"von_mises\", \"max_principal\"]\nprobe = \"roi\"",
+            self.sample_interval, self.vtk
+        );
+        s
+    }
+}
+
+/// The ROI samples of a finished run (`probe.csv`).
+#[derive(Clone, Debug, Default)]
+pub struct ProbeSamples {
+    /// Sample times (s).
+    pub time: Vec<f64>,
+    /// Hand force along the pressing direction (N) at each sample (`hand_reaction`).
+    pub force: Vec<f64>,
+    /// Hand travel along the pressing direction (m) at each sample (`hand_travel`): the
+    /// indentation, as the fingers start on the skin.
+    pub depth: Vec<f64>,
+    /// ROI element ids.
+    pub elements: Vec<u32>,
+    /// Maximum principal Cauchy stress (Pa), one row per sample, one column per ROI element.
+    pub stress: Vec<Vec<f64>>,
+}
+
+/// Read `probe.csv` of a run directory whose hand is named `hand`.
+pub fn read_probe(dir: &Path, hand: &str) -> Result<ProbeSamples, String> {
+    let (cols, rows) = read_history(&dir.join("probe.csv"))?;
+    let get = |name: &str| {
+        column(&cols, &rows, name)
+            .ok_or_else(|| format!("{}: no column `{name}`", dir.join("probe.csv").display()))
+    };
+    let time = get("time")?;
+    let force = get(&format!("{hand}_reaction"))?;
+    let depth = get(&format!("{hand}_travel"))?;
+    let idx: Vec<(usize, u32)> = cols
+        .iter()
+        .enumerate()
+        .filter_map(|(i, c)| {
+            c.strip_prefix('e')
+                .and_then(|n| n.parse().ok())
+                .map(|e| (i, e))
+        })
+        .collect();
+    Ok(ProbeSamples {
+        time,
+        force,
+        depth,
+        elements: idx.iter().map(|x| x.1).collect(),
+        stress: rows
+            .iter()
+            .map(|r| idx.iter().map(|&(i, _)| r[i]).collect())
+            .collect(),
+    })
+}
