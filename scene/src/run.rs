@@ -14,6 +14,68 @@ use std::path::Path;
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Instant;
 
+/// How a run ended. Written as `completed`, `converged`, `stopped` or `failed: <error>` (in
+/// `summary.json` and a campaign run's `done.json`).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub enum RunStatus {
+    /// Reached its end time.
+    Completed,
+    /// A relaxation run whose residual fell below its tolerance.
+    Converged,
+    /// Stopped on request (Ctrl-C), with complete output up to the last frame.
+    Stopped,
+    /// Failed with this error.
+    Failed(String),
+}
+
+impl RunStatus {
+    /// Whether the run reached its end (completed or converged).
+    pub fn finished(&self) -> bool {
+        matches!(self, RunStatus::Completed | RunStatus::Converged)
+    }
+}
+
+impl std::fmt::Display for RunStatus {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            RunStatus::Completed => f.write_str("completed"),
+            RunStatus::Converged => f.write_str("converged"),
+            RunStatus::Stopped => f.write_str("stopped"),
+            RunStatus::Failed(e) => write!(f, "failed: {e}"),
+        }
+    }
+}
+
+impl std::str::FromStr for RunStatus {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s {
+            "completed" => Ok(RunStatus::Completed),
+            "converged" => Ok(RunStatus::Converged),
+            "stopped" => Ok(RunStatus::Stopped),
+            _ => match s.strip_prefix("failed: ") {
+                Some(e) => Ok(RunStatus::Failed(e.to_string())),
+                None => Err(format!(
+                    "unknown run status `{s}` (completed, converged, stopped or failed: ...)"
+                )),
+            },
+        }
+    }
+}
+
+impl Serialize for RunStatus {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        s.collect_str(self)
+    }
+}
+
+impl<'de> serde::Deserialize<'de> for RunStatus {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        let s = String::deserialize(d)?;
+        s.parse().map_err(serde::de::Error::custom)
+    }
+}
+
 /// Where the time went, per stage.
 #[derive(Clone, Debug, Serialize)]
 pub struct StageShare {
@@ -43,8 +105,8 @@ pub struct PartMassReport {
 pub struct RunSummary {
     /// Scene title.
     pub title: String,
-    /// How the run ended: `completed`, `converged`, `stopped` or the error.
-    pub status: String,
+    /// How the run ended: `completed`, `converged`, `stopped` or `failed: ` and the error.
+    pub status: RunStatus,
     /// Simulated time reached (s).
     pub time: f64,
     /// Steps.
@@ -379,145 +441,211 @@ pub fn run_scene(
     scene: &mut Scene,
     out: &Path,
     stop: &AtomicBool,
-    mut observer: impl FnMut(&Progress),
+    observer: impl FnMut(&Progress),
 ) -> (RunSummary, Option<String>) {
     let t_wall = Instant::now();
     let mut error = None;
-    let mut status = "completed".to_string();
     if let Err(e) = std::fs::create_dir_all(out) {
         error = Some(format!(
             "{}: cannot create the output directory: {e}",
             out.display()
         ));
     }
-    let stem = "frame";
-    let mut series = Series::new(out, stem);
-    let reactions = scene.output.reactions.clone();
-    let mut history = History::new(
-        &out.join("history.csv"),
-        history_columns(&scene.sim, &reactions),
-    );
-    let mut row = Vec::new();
-    let end = scene.end_time;
-    let hist_dt = scene.output.history_interval.max(0.0);
-    let vtk_dt = scene.output.frame_interval;
-    let write_vtk = scene.output.vtk_interval.is_some();
-    let mut probe = scene.output.probe.as_ref().map(|(_, els)| {
-        let mut cols = vec!["time".to_string()];
-        for st in &scene.sim.stages {
-            cols.extend(st.history_columns());
-        }
-        let mut tcols = cols.clone();
-        cols.extend(els.iter().map(|e| format!("e{e}")));
-        for e in els {
-            for c in ["xx", "yy", "zz", "xy", "yz", "zx"] {
-                tcols.push(format!("e{e}_{c}"));
-            }
-        }
-        (
-            History::new(&out.join("probe.csv"), cols),
-            History::new(&out.join("probe_stress.csv"), tcols),
-        )
-    });
-    let mut next_hist = 0.0;
-    let mut next_vtk = 0.0;
-    let mut peaks = EnergyPeaks::default();
-    let mut last_flush = Instant::now();
+    let mut rec = Recorder::new(scene, out);
     if error.is_none() {
         if let Err(e) = scene.sim.initialise() {
             error = Some(e.to_string());
         }
     }
-    while error.is_none() {
+    let mut status = RunStatus::Completed;
+    if error.is_none() {
+        match time_loop(scene, &mut rec, stop, observer) {
+            Ok(s) => status = s,
+            Err(e) => error = Some(e),
+        }
+    }
+    if let Err(e) = rec.history.flush() {
+        error.get_or_insert(e);
+    }
+    if let Some((p, pt)) = &rec.probe {
+        if let Err(e) = p.flush().and_then(|_| pt.flush()) {
+            error.get_or_insert(e);
+        }
+    }
+    if let Some(e) = &error {
+        status = RunStatus::Failed(e.clone());
+    }
+    let summary = summarise(scene, t_wall.elapsed().as_secs_f64(), status, &rec);
+    if let Ok(js) = serde_json::to_string_pretty(&summary) {
+        if let Err(e) =
+            solver::output::atomic::write_atomic(&out.join("summary.json"), js.as_bytes())
+        {
+            error.get_or_insert(e);
+        }
+    }
+    (summary, error)
+}
+
+/// The output files of a run and their clocks: `history.csv`, the VTK frames, the probes.
+struct Recorder {
+    series: Series,
+    history: History,
+    /// `probe.csv` and `probe_stress.csv`, when the scene probes elements.
+    probe: Option<(History, History)>,
+    reactions: Vec<(String, Vec<u32>)>,
+    row: Vec<f64>,
+    hist_dt: f64,
+    vtk_dt: Option<f64>,
+    write_vtk: bool,
+    next_hist: f64,
+    next_vtk: f64,
+    peaks: EnergyPeaks,
+    last_flush: Instant,
+}
+
+impl Recorder {
+    fn new(scene: &Scene, out: &Path) -> Recorder {
+        let reactions = scene.output.reactions.clone();
+        let history = History::new(
+            &out.join("history.csv"),
+            history_columns(&scene.sim, &reactions),
+        );
+        let probe = scene.output.probe.as_ref().map(|(_, els)| {
+            let mut cols = vec!["time".to_string()];
+            for st in &scene.sim.stages {
+                cols.extend(st.history_columns());
+            }
+            let mut tcols = cols.clone();
+            cols.extend(els.iter().map(|e| format!("e{e}")));
+            for e in els {
+                for c in ["xx", "yy", "zz", "xy", "yz", "zx"] {
+                    tcols.push(format!("e{e}_{c}"));
+                }
+            }
+            (
+                History::new(&out.join("probe.csv"), cols),
+                History::new(&out.join("probe_stress.csv"), tcols),
+            )
+        });
+        Recorder {
+            series: Series::new(out, "frame"),
+            history,
+            probe,
+            reactions,
+            row: Vec::new(),
+            hist_dt: scene.output.history_interval.max(0.0),
+            vtk_dt: scene.output.frame_interval,
+            write_vtk: scene.output.vtk_interval.is_some(),
+            next_hist: 0.0,
+            next_vtk: 0.0,
+            peaks: EnergyPeaks::default(),
+            last_flush: Instant::now(),
+        }
+    }
+
+    /// Append the history row, and write a frame and the probe rows, when their clocks are due
+    /// (or `done`: the last state). An error names the file that could not be written.
+    fn sample(&mut self, scene: &Scene, done: bool) -> Result<(), String> {
         let sim = &scene.sim;
         let t = sim.time;
-        let done = t >= end * (1.0 - 1e-12);
-        if t >= next_hist || done {
-            history_row(sim, &reactions, &mut row);
-            history.push(&row);
-            next_hist = next_output_time(next_hist + hist_dt, hist_dt, t);
-            peaks.record(sim, end);
+        if t >= self.next_hist || done {
+            history_row(sim, &self.reactions, &mut self.row);
+            self.history.push(&self.row);
+            self.next_hist = next_output_time(self.next_hist + self.hist_dt, self.hist_dt, t);
+            self.peaks.record(sim, scene.end_time);
         }
-        if let Some(vdt) = vtk_dt {
-            if t >= next_vtk * (1.0 - 1e-12) || done {
-                if let Some((p, pt)) = probe.as_mut() {
-                    probe_rows(scene, p, pt, &mut row);
-                }
-                let written = if write_vtk {
-                    write_frame(scene, &mut series)
-                } else {
-                    Ok(())
-                };
-                if let Err(e) = written
-                    .and_then(|_| history.flush())
-                    .and_then(|_| match &probe {
-                        Some((p, pt)) => p.flush().and_then(|_| pt.flush()),
-                        None => Ok(()),
-                    })
-                {
-                    error = Some(e);
-                    break;
-                }
-                last_flush = Instant::now();
-                next_vtk = next_output_time(next_vtk + vdt, vdt, t);
+        let Some(vdt) = self.vtk_dt else {
+            return Ok(());
+        };
+        if t >= self.next_vtk * (1.0 - 1e-12) || done {
+            if let Some((p, pt)) = self.probe.as_mut() {
+                probe_rows(scene, p, pt, &mut self.row);
             }
+            if self.write_vtk {
+                write_frame(scene, &mut self.series)?;
+            }
+            self.history.flush()?;
+            if let Some((p, pt)) = &self.probe {
+                p.flush().and_then(|_| pt.flush())?;
+            }
+            self.last_flush = Instant::now();
+            self.next_vtk = next_output_time(self.next_vtk + vdt, vdt, t);
         }
+        Ok(())
+    }
+
+    /// The last history row (and frame) of a run that converged.
+    fn converged(&mut self, scene: &Scene) {
+        history_row(&scene.sim, &self.reactions, &mut self.row);
+        self.history.push(&self.row);
+        if self.write_vtk {
+            let _ = write_frame(scene, &mut self.series);
+        }
+    }
+
+    /// The history row of the state that went unstable.
+    fn unstable(&mut self, scene: &Scene) {
+        history_row(&scene.sim, &self.reactions, &mut self.row);
+        self.history.push(&self.row);
+        self.peaks.record(&scene.sim, scene.end_time);
+    }
+
+    /// Flush `history.csv` if it was last flushed more than 10 s ago.
+    fn flush_now_and_then(&mut self) {
+        if self.last_flush.elapsed().as_secs_f64() > 10.0 {
+            let _ = self.history.flush();
+            self.last_flush = Instant::now();
+        }
+    }
+}
+
+/// Step the scene to its end time (or convergence, or a stop request), sampling the output.
+fn time_loop(
+    scene: &mut Scene,
+    rec: &mut Recorder,
+    stop: &AtomicBool,
+    mut observer: impl FnMut(&Progress),
+) -> Result<RunStatus, String> {
+    let end = scene.end_time;
+    loop {
+        let done = scene.sim.time >= end * (1.0 - 1e-12);
+        rec.sample(scene, done)?;
         if done {
-            break;
+            return Ok(RunStatus::Completed);
         }
         if let Some(r) = scene.sim.settings.relaxation {
             if scene.sim.step > 10 && scene.sim.residual < r.tolerance {
-                status = "converged".into();
-                history_row(&scene.sim, &reactions, &mut row);
-                history.push(&row);
-                if write_vtk {
-                    let _ = write_frame(scene, &mut series);
-                }
-                break;
+                rec.converged(scene);
+                return Ok(RunStatus::Converged);
             }
         }
         if stop.load(Ordering::Relaxed) {
-            status = "stopped".into();
-            break;
+            return Ok(RunStatus::Stopped);
         }
-        let stress_at = vtk_dt
-            .map(|_| next_vtk * (1.0 - 1e-12))
+        let stress_at = rec
+            .vtk_dt
+            .map(|_| rec.next_vtk * (1.0 - 1e-12))
             .unwrap_or(f64::INFINITY)
             .min(end * (1.0 - 1e-12));
         if let Err(e) = scene.sim.step(stress_at) {
             if let SolverError::Unstable(_) = e {
                 // the history ends with the state that went unstable
-                history_row(&scene.sim, &reactions, &mut row);
-                history.push(&row);
-                peaks.record(&scene.sim, end);
+                rec.unstable(scene);
             }
-            error = Some(format!("{}: {e}", scene.path.display()));
-            break;
+            return Err(format!("{}: {e}", scene.path.display()));
         }
         if scene.sim.step % 64 == 0 {
             observer(&Progress {
                 sim: &scene.sim,
                 end_time: end,
             });
-            if last_flush.elapsed().as_secs_f64() > 10.0 {
-                let _ = history.flush();
-                last_flush = Instant::now();
-            }
+            rec.flush_now_and_then();
         }
     }
-    if let Err(e) = history.flush() {
-        error.get_or_insert(e);
-    }
-    if let Some((p, pt)) = &probe {
-        if let Err(e) = p.flush().and_then(|_| pt.flush()) {
-            error.get_or_insert(e);
-        }
-    }
-    if let Some(e) = &error {
-        status = format!("failed: {e}");
-    }
-    let sim = &scene.sim;
-    let wall = t_wall.elapsed().as_secs_f64();
+}
+
+/// Where the wall time went: each timed stage, then output and bookkeeping (the rest).
+fn stage_times(sim: &Simulation, wall: f64) -> Vec<StageShare> {
     let total_stage: f64 = sim.timers.iter().map(|s| s.time.as_secs_f64()).sum();
     let mut stage_times: Vec<StageShare> = sim
         .timers
@@ -534,9 +662,17 @@ pub fn run_scene(
         seconds: (wall - total_stage).max(0.0),
         share: (wall - total_stage).max(0.0) / wall,
     });
+    stage_times
+}
+
+/// The run summary of `scene` after `wall` seconds.
+fn summarise(scene: &Scene, wall: f64, status: RunStatus, rec: &Recorder) -> RunSummary {
+    let sim = &scene.sim;
+    let peaks = &rec.peaks;
+    let stage_times = stage_times(sim, wall);
     let e = &sim.energy;
     let hourglass = HourglassReport::of(sim);
-    let summary = RunSummary {
+    RunSummary {
         title: scene.title.clone(),
         status,
         time: sim.time,
@@ -582,27 +718,37 @@ pub fn run_scene(
         warnings: energy_warnings(e.internal, e.hourglass, &hourglass),
         hourglass,
         threads: rayon::current_num_threads(),
-        frames: series.len(),
+        frames: rec.series.len(),
         eroded_elements: sim.erosion.count,
         first_eroded: sim.erosion.first.map(|(element, time)| ErodedElement {
             element,
             part: sim.part_of(element),
             time,
         }),
-    };
-    if let Ok(js) = serde_json::to_string_pretty(&summary) {
-        if let Err(e) =
-            solver::output::atomic::write_atomic(&out.join("summary.json"), js.as_bytes())
-        {
-            error.get_or_insert(e);
-        }
     }
-    (summary, error)
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn run_status_reads_back_what_it_writes() {
+        for st in [
+            RunStatus::Completed,
+            RunStatus::Converged,
+            RunStatus::Stopped,
+            RunStatus::Failed("scene.toml: element 7 inverted at t = 1.2 ms".into()),
+        ] {
+            let js = serde_json::to_string(&st).unwrap();
+            assert_eq!(serde_json::from_str::<RunStatus>(&js).unwrap(), st, "{js}");
+        }
+        assert_eq!(
+            serde_json::to_string(&RunStatus::Failed("x".into())).unwrap(),
+            "\"failed: x\""
+        );
+        assert!("done".parse::<RunStatus>().is_err());
+    }
 
     #[test]
     fn hourglass_energy_above_a_tenth_of_the_internal_energy_is_warned_about() {

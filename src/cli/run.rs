@@ -3,6 +3,7 @@
 
 use super::input::{load, print_report, DeckArgs};
 use super::progress::{stop_flag, time_bar};
+use scene::run::RunStatus;
 use scene::run::{run_scene, RunSummary};
 use scene::Scene;
 use std::path::Path;
@@ -107,7 +108,7 @@ pub fn run(scene_path: &Path, out: &Path, quiet: bool, deck: &DeckArgs) -> Resul
     println!("  output: {}", out.display());
     match err {
         Some(e) => Err(e),
-        None if summary.status == "stopped" => {
+        None if summary.status == RunStatus::Stopped => {
             // Ctrl-C: the output up to the stop is complete, but the run is not.
             eprintln!(
                 "stopped by Ctrl-C at {:.4} ms of {:.4} ms; {} holds the output up to there",

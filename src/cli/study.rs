@@ -3,6 +3,7 @@
 //! [`verification::study`]. Writes `study.csv`, `study.md` and the Pareto plots.
 
 use indicatif::{ProgressBar, ProgressStyle};
+use scene::run::RunStatus;
 use solver::output::atomic::write_atomic;
 use std::path::Path;
 
@@ -36,7 +37,7 @@ pub fn study(quick: bool, out: &Path, quiet: bool) -> Result<(), String> {
     write_atomic(&out.join("study.md"), md.as_bytes())?;
     let files = verification::study::plots(&rows, out)?;
     println!("{md}");
-    for r in rows.iter().filter(|r| r.status != "completed") {
+    for r in rows.iter().filter(|r| r.status != RunStatus::Completed) {
         println!("  {} = {}: {}", r.knob, r.setting, r.status);
     }
     println!(

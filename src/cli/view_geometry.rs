@@ -94,7 +94,8 @@ pub fn for_dataset(dataset: &Path) -> Result<Option<ViewGeometry>, String> {
         let v: Vec<f64> = a.iter().filter_map(|x| x.as_f64()).collect();
         (v.len() == 3).then(|| [v[0], v[1], v[2]])
     });
-    let p = campaign::phantom_params_from_json(params, centre)
+    let p = campaign::PhantomRecord::from_value(params)
+        .and_then(|r| r.to_params(centre))
         .map_err(|e| format!("{}: manifest: {e}", dataset.display()))?;
     let ph = phantom::build(&p)
         .map_err(|e| format!("{}: rebuilding its phantom: {e}", dataset.display()))?;

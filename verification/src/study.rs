@@ -316,7 +316,7 @@ pub fn to_csv(rows: &[StudyRow]) -> String {
             r.peak_force,
             r.force_error,
             r.stress_error,
-            r.status.replace(',', ";")
+            r.status.to_string().replace(',', ";")
         );
     }
     s

@@ -113,7 +113,7 @@ pub fn run(quick: bool, mut progress: impl FnMut(usize, &str)) -> Vec<StudyRow> 
                     peak_force: r.force,
                     force_error: (r.force - f_hertz).abs() / f_hertz,
                     stress_error: f64::NAN,
-                    status: "completed".into(),
+                    status: scene::run::RunStatus::Completed,
                 },
                 Err(e) => StudyRow::failed(knob, setting, e),
             }

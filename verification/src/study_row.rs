@@ -1,6 +1,8 @@
 //! A row of `palpa study` ([`StudyRow`]): one setting of one knob, its cost and its errors,
 //! from the palpation study ([`crate::study`]) or its Hertz block ([`crate::study_hertz`]).
 
+use scene::run::RunStatus;
+
 /// One run of the study.
 #[derive(Clone, Debug)]
 pub struct StudyRow {
@@ -27,8 +29,8 @@ pub struct StudyRow {
     pub force_error: f64,
     /// Relative RMS ROI stress error against `against`.
     pub stress_error: f64,
-    /// `completed` or the error.
-    pub status: String,
+    /// How its run ended.
+    pub status: RunStatus,
 }
 
 impl StudyRow {
@@ -46,7 +48,7 @@ impl StudyRow {
             peak_force: f64::NAN,
             force_error: f64::NAN,
             stress_error: f64::NAN,
-            status: format!("failed: {e}"),
+            status: RunStatus::Failed(e),
         }
     }
 

@@ -1,0 +1,187 @@
+//! The description file of a campaign directory (`campaign.json`): format, solver version,
+//! shard and the [`CampaignPlan`]. A resumed campaign, the shards of a merge and a merge's target
+//! must agree on the plan; [`first_difference`] names where two plans part.
+
+use crate::plan::CampaignPlan;
+use crate::shard::shard_in;
+use crate::{CAMPAIGN_FILE, CAMPAIGN_FORMAT};
+use serde_json::{json, Value};
+use solver::output::atomic::write_atomic;
+use std::path::Path;
+
+/// Read a JSON file; an error names it.
+pub fn read_json(path: &Path) -> Result<Value, String> {
+    let s = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
+    serde_json::from_str(&s).map_err(|e| format!("{}: {e}", path.display()))
+}
+
+/// Write `v` as pretty JSON, atomically.
+pub fn write_json(path: &Path, v: &Value) -> Result<(), String> {
+    let s = serde_json::to_string_pretty(v).map_err(|e| e.to_string())?;
+    write_atomic(path, s.as_bytes())
+}
+
+/// The campaign description file of a directory: format, solver version, shard and plan.
+pub fn campaign_file(plan: &Value, shard: Option<(usize, usize)>) -> Value {
+    json!({
+        "format": CAMPAIGN_FORMAT,
+        "version": 1,
+        "solver_version": env!("CARGO_PKG_VERSION"),
+        "shard": shard.map(|(i, n)| format!("{i}/{n}")),
+        "plan": plan,
+    })
+}
+
+/// A campaign directory's description as read back: its shard and its plan (as written, for
+/// comparisons, and typed).
+pub struct CampaignDir {
+    /// The shard it holds, `None` when unsharded.
+    pub shard: Option<(usize, usize)>,
+    /// The plan as JSON.
+    pub plan_value: Value,
+    /// The solver version that wrote it.
+    pub solver_version: Value,
+}
+
+/// Read `dir`'s `campaign.json`; an error names the file when it is not a palpa campaign.
+pub fn read_campaign_dir(dir: &Path) -> Result<CampaignDir, String> {
+    let file = dir.join(CAMPAIGN_FILE);
+    let v = read_json(&file)?;
+    if v["format"] != CAMPAIGN_FORMAT {
+        return Err(format!("{}: not a palpa campaign", file.display()));
+    }
+    Ok(CampaignDir {
+        shard: shard_in(&v, &file)?,
+        plan_value: v.get("plan").cloned().unwrap_or(Value::Null),
+        solver_version: v.get("solver_version").cloned().unwrap_or(Value::Null),
+    })
+}
+
+impl CampaignDir {
+    /// The typed plan.
+    pub fn plan(&self) -> Result<CampaignPlan, String> {
+        CampaignPlan::from_value(&self.plan_value)
+    }
+}
+
+/// Where two campaign plans first differ, for the message that refuses to mix them:
+/// `plan.locations[26].surface_m[0]: -0.0705 there, -0.0725 here`. `None` when equal.
+pub fn first_difference(there: &Value, here: &Value, path: &str) -> Option<String> {
+    let short = |v: &Value| {
+        let s = v.to_string();
+        if s.chars().count() > 60 {
+            format!("{}...", s.chars().take(57).collect::<String>())
+        } else {
+            s
+        }
+    };
+    match (there, here) {
+        (Value::Object(a), Value::Object(b)) => {
+            let mut keys: Vec<&String> = a.keys().chain(b.keys()).collect();
+            keys.sort();
+            keys.dedup();
+            keys.into_iter().find_map(|k| {
+                let (x, y) = (a.get(k), b.get(k));
+                match (x, y) {
+                    (Some(x), Some(y)) => first_difference(x, y, &format!("{path}.{k}")),
+                    _ => Some(format!(
+                        "{path}.{k}: {} there, {} here",
+                        x.map_or("absent".into(), short),
+                        y.map_or("absent".into(), short)
+                    )),
+                }
+            })
+        }
+        (Value::Array(a), Value::Array(b)) if a.len() == b.len() => a
+            .iter()
+            .zip(b)
+            .enumerate()
+            .find_map(|(i, (x, y))| first_difference(x, y, &format!("{path}[{i}]"))),
+        (Value::Array(a), Value::Array(b)) => Some(format!(
+            "{path}: {} entries there, {} here",
+            a.len(),
+            b.len()
+        )),
+        _ if there != here => Some(format!(
+            "{path}: {} there, {} here",
+            short(there),
+            short(here)
+        )),
+        _ => None,
+    }
+}
+
+/// Make `out` the directory of this campaign (`plan`, `shard`): create it, refuse one that holds
+/// another campaign (naming where the plans part) or finished runs without `resume`, and write
+/// `campaign.json`. Returns the solver version of the finished runs when it is not this one.
+pub fn prepare_dir(
+    out: &Path,
+    plan: &CampaignPlan,
+    shard: Option<(usize, usize)>,
+    n_done: usize,
+    resume: bool,
+) -> Result<Option<Value>, String> {
+    std::fs::create_dir_all(out)
+        .map_err(|e| format!("{}: cannot create the output directory: {e}", out.display()))?;
+    let cfile = out.join(CAMPAIGN_FILE);
+    let plan = plan.to_value();
+    let desc = campaign_file(&plan, shard);
+    let mut other_version = None;
+    if cfile.exists() {
+        let old = read_json(&cfile)?;
+        if let Some(d) = first_difference(old.get("plan").unwrap_or(&Value::Null), &plan, "plan") {
+            return Err(format!(
+                "{} holds a different campaign ({d}; there = {}, here = this campaign file and palpa); choose a new --out",
+                out.display(),
+                cfile.display()
+            ));
+        }
+        if old.get("solver_version") != desc.get("solver_version") {
+            other_version = Some(old.get("solver_version").cloned().unwrap_or(Value::Null));
+        }
+    }
+    if n_done > 0 && !resume {
+        return Err(format!(
+            "{} already holds {n_done} finished run(s) of this campaign: pass --resume to continue it, or choose a new --out",
+            out.display()
+        ));
+    }
+    write_json(&cfile, &desc)?;
+    Ok(other_version)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::first_difference;
+    use serde_json::json;
+
+    #[test]
+    fn first_difference_names_the_path_and_both_values() {
+        let there =
+            json!({"runs": [1, 2], "locations": [{"label": "A", "surface_m": [-0.0705, 0.1785]}]});
+        let mut here = there.clone();
+        assert_eq!(first_difference(&there, &here, "plan"), None);
+        here["locations"][0]["surface_m"][0] = json!(-0.0725);
+        assert_eq!(
+            first_difference(&there, &here, "plan").as_deref(),
+            Some("plan.locations[0].surface_m[0]: -0.0705 there, -0.0725 here")
+        );
+        here["runs"] = json!([1, 2, 3]);
+        here["title"] = json!("new");
+        // keys in sorted order: locations, runs, title
+        assert_eq!(
+            first_difference(&there, &here, "plan").as_deref(),
+            Some("plan.locations[0].surface_m[0]: -0.0705 there, -0.0725 here")
+        );
+        here["locations"] = there["locations"].clone();
+        assert_eq!(
+            first_difference(&there, &here, "plan").as_deref(),
+            Some("plan.runs: 2 entries there, 3 here")
+        );
+        here["runs"] = json!([1, 2]);
+        assert_eq!(
+            first_difference(&there, &here, "plan").as_deref(),
+            Some("plan.title: absent there, \"new\" here")
+        );
+    }
+}

@@ -1,0 +1,339 @@
+//! A resolved campaign ([`Campaign`]: locations, runs, the settings they share) and its plan
+//! ([`CampaignPlan`]): the campaign on its built phantom, in SI, as `campaign.json` records it.
+//! Shards and resumed invocations of one campaign must have the same plan; `palpa campaign
+//! merge` and the dataset read it back. Every field is typed; the file's keys are sorted (the
+//! plan is written through [`serde_json::Value`]), so that a plan reads back to the same bytes.
+
+use crate::phantom_record::PhantomRecord;
+use crate::spec::CampaignSpec;
+use phantom::{location_at, Location, Phantom, PhantomParams};
+use scene::build::build_scene_with;
+use scene::palpation::{PalpationSetup, Place};
+use scene::{Scene, SceneSpec};
+use serde::{Deserialize, Serialize};
+use solver::element::precision::Precision;
+use solver::output::atomic::write_atomic;
+use std::collections::BTreeMap;
+use std::path::Path;
+
+/// Training or test location.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Split {
+    /// Used for training (dataset split 0).
+    Train,
+    /// Held out (dataset split 1).
+    Test,
+}
+
+impl Split {
+    /// 0 for train, 1 for test.
+    pub fn code(self) -> u8 {
+        match self {
+            Split::Train => 0,
+            Split::Test => 1,
+        }
+    }
+    /// "train" or "test".
+    pub fn name(self) -> &'static str {
+        match self {
+            Split::Train => "train",
+            Split::Test => "test",
+        }
+    }
+}
+
+/// One location of a campaign.
+#[derive(Clone, Debug, PartialEq)]
+pub struct CampaignLocation {
+    /// Label (a phantom location's name, or the point's name).
+    pub label: String,
+    /// Train or test.
+    pub split: Split,
+    /// Where the fingers press.
+    pub place: Place,
+}
+
+/// One run of a campaign.
+#[derive(Clone, Debug, PartialEq)]
+pub struct PlannedRun {
+    /// Position in the campaign's order (0-based).
+    pub index: usize,
+    /// Directory name under `runs/`.
+    pub label: String,
+    /// Index into [`Campaign::locations`].
+    pub location: usize,
+    /// Indentation depth (m).
+    pub depth: f64,
+    /// Time to reach it (s).
+    pub duration: f64,
+}
+
+/// A resolved campaign: the common palpation settings, the locations and the runs.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Campaign {
+    /// Title.
+    pub title: String,
+    /// Settings shared by every run (its place, depth and duration are replaced per run).
+    pub base: PalpationSetup,
+    /// Locations in order.
+    pub locations: Vec<CampaignLocation>,
+    /// Runs in order.
+    pub runs: Vec<PlannedRun>,
+}
+
+impl Campaign {
+    /// The paper's protocol (the defaults of every key).
+    pub fn paper() -> Campaign {
+        CampaignSpec::default()
+            .resolve()
+            .expect("the default campaign is valid")
+    }
+
+    /// The palpation of run `r`.
+    pub fn setup(&self, r: &PlannedRun) -> PalpationSetup {
+        PalpationSetup {
+            title: format!("{}: {}", self.title, r.label),
+            place: self.locations[r.location].place.clone(),
+            depth: r.depth,
+            duration: r.duration,
+            ..self.base.clone()
+        }
+    }
+
+    /// Samples each run records: at 0, sample_interval, ... up to the duration.
+    pub fn samples_per_run(&self, r: &PlannedRun) -> usize {
+        (r.duration / self.base.sample_interval * (1.0 + 1e-9)).floor() as usize + 1
+    }
+
+    /// The phantom parameters every run's scene asks for (read back from the scene text, so
+    /// that a phantom built from them is reused by [`build_scene_with`]).
+    pub fn phantom_params(&self) -> Result<PhantomParams, String> {
+        let src = self.base.scene_toml();
+        let spec: SceneSpec =
+            toml::from_str(&src).map_err(|e| format!("internal: campaign scene: {e}"))?;
+        spec.mesh.phantom.unwrap_or_default().to_params()
+    }
+
+    /// Resolve each location on the built phantom (its skin point); an error names a location
+    /// that does not exist or is not over the skin.
+    pub fn resolve_locations(&self, ph: &Phantom) -> Result<Vec<Location>, String> {
+        self.locations
+            .iter()
+            .map(|l| match &l.place {
+                Place::Named(n) => ph
+                    .locations
+                    .get(n)
+                    .cloned()
+                    .ok_or_else(|| format!("location {n}: the phantom has no such location")),
+                Place::At(x, y) => {
+                    location_at(&ph.mesh, &ph.skin_faces, &ph.volume, &l.label, *x, *y)
+                        .map_err(|e| format!("location {}: {e}", l.label))
+                }
+            })
+            .collect()
+    }
+
+    /// Write run `r`'s `scene.toml` into `dir` and build it, reusing `phantom`.
+    pub fn build_run_scene(
+        &self,
+        r: &PlannedRun,
+        dir: &Path,
+        phantom: &Phantom,
+    ) -> Result<Scene, String> {
+        std::fs::create_dir_all(dir)
+            .map_err(|e| format!("{}: cannot create the run directory: {e}", dir.display()))?;
+        let path = dir.join("scene.toml");
+        let src = self.setup(r).scene_toml();
+        write_atomic(&path, src.as_bytes())?;
+        let spec: SceneSpec = toml::from_str(&src)
+            .map_err(|e| format!("{}: {}", path.display(), e.to_string().trim_end()))?;
+        build_scene_with(spec, &path, &src, Some(phantom.clone()))
+    }
+
+    /// The plan of this campaign on the built phantom `ph` with its resolved locations `locs`:
+    /// what must agree between its shards and resumed invocations.
+    pub fn plan(&self, ph: &Phantom, locs: &[Location]) -> CampaignPlan {
+        let b = &self.base;
+        CampaignPlan {
+            title: self.title.clone(),
+            settings: PlanSettings {
+                sample_interval_s: b.sample_interval,
+                finger_diameter_m: b.finger_diameter,
+                finger_spacing_m: b.finger_spacing,
+                element: b.element.label().into(),
+                dt_factor: b.dt_factor,
+                mass_scaling: b.mass_scaling.map(|t| t.to_string()),
+                mass_scaling_limit: b.mass_scaling_limit,
+                vtk: b.vtk,
+                // only when given, so that the plans of earlier campaigns still match on --resume
+                element_by_part: b
+                    .part_elements
+                    .iter()
+                    .map(|(k, v)| (k.clone(), v.label().to_string()))
+                    .collect(),
+                // the incompressibility knob changes every run's physics: part of the identity
+                max_bulk_ratio: b.max_bulk_ratio,
+                // so does the kernels' precision (only when not the default, as above)
+                precision: (b.precision != Precision::F64).then(|| b.precision.label().into()),
+            },
+            phantom: PhantomRecord::of(&ph.params),
+            roi: PlanRoi {
+                center_m: ph.roi.center,
+                elements: ph.roi.elements.clone(),
+                centroids_m: ph.roi.centroids.clone(),
+            },
+            locations: self
+                .locations
+                .iter()
+                .zip(locs)
+                .map(|(l, s)| PlanLocation {
+                    label: l.label.clone(),
+                    split: l.split,
+                    kind: match l.place {
+                        Place::Named(_) => PlaceKind::Phantom,
+                        Place::At(..) => PlaceKind::Point,
+                    },
+                    surface_m: s.surface,
+                    liver_depth_m: s.liver_depth,
+                    under_ribs: s.under_ribs,
+                })
+                .collect(),
+            runs: self
+                .runs
+                .iter()
+                .map(|r| PlanRun {
+                    index: r.index,
+                    label: r.label.clone(),
+                    location: self.locations[r.location].label.clone(),
+                    depth_m: r.depth,
+                    duration_s: r.duration,
+                    samples: self.samples_per_run(r),
+                })
+                .collect(),
+        }
+    }
+}
+
+/// The plan of a campaign: settings, phantom, ROI, resolved locations and runs (SI).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct CampaignPlan {
+    /// Title.
+    pub title: String,
+    /// The palpation settings every run shares.
+    pub settings: PlanSettings,
+    /// The phantom's parameters.
+    pub phantom: PhantomRecord,
+    /// The region of interest whose stress the dataset holds.
+    pub roi: PlanRoi,
+    /// Locations in order, with their skin points.
+    pub locations: Vec<PlanLocation>,
+    /// Runs in order.
+    pub runs: Vec<PlanRun>,
+}
+
+/// The palpation settings of a plan.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct PlanSettings {
+    /// Sample interval (s).
+    pub sample_interval_s: f64,
+    /// Finger diameter (m).
+    pub finger_diameter_m: f64,
+    /// Finger spacing (m).
+    pub finger_spacing_m: f64,
+    /// Element formulation (`one_point`, `stiffness`, `full_fbar`, ...).
+    pub element: String,
+    /// Time-step factor.
+    pub dt_factor: f64,
+    /// Mass-scaling target (`initial`, `2 x initial`, `4 us`), `None` when off.
+    pub mass_scaling: Option<String>,
+    /// Added mass (fraction of a part's mass) at which a run stops.
+    pub mass_scaling_limit: f64,
+    /// Whether runs write VTK frames.
+    pub vtk: bool,
+    /// Per-part formulations; absent from the file when empty.
+    #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
+    pub element_by_part: BTreeMap<String, String>,
+    /// The K/G cap; absent when none.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub max_bulk_ratio: Option<f64>,
+    /// The element kernels' precision; absent when `f64` (the default).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub precision: Option<String>,
+}
+
+/// The ROI of a plan.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct PlanRoi {
+    /// Its centre (m).
+    pub center_m: [f64; 3],
+    /// Element ids, nearest to the centre first.
+    pub elements: Vec<u32>,
+    /// Element centroids (m), in the same order.
+    pub centroids_m: Vec<[f64; 3]>,
+}
+
+/// How a location was given.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum PlaceKind {
+    /// A location of the phantom (A, B, C, P01..P25).
+    Phantom,
+    /// A point (x, y) of the skin.
+    Point,
+}
+
+/// One location of a plan.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct PlanLocation {
+    /// Label.
+    pub label: String,
+    /// Train or test.
+    pub split: Split,
+    /// How it was given.
+    pub kind: PlaceKind,
+    /// Its skin point (m).
+    pub surface_m: [f64; 3],
+    /// Depth of the liver below it (m), `None` where no liver is below.
+    pub liver_depth_m: Option<f64>,
+    /// Whether ribs lie between skin and liver.
+    pub under_ribs: bool,
+}
+
+/// One run of a plan.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct PlanRun {
+    /// Position in the campaign's order (0-based).
+    pub index: usize,
+    /// Directory name under `runs/`.
+    pub label: String,
+    /// Its location's label.
+    pub location: String,
+    /// Indentation depth (m).
+    pub depth_m: f64,
+    /// Time to reach it (s).
+    pub duration_s: f64,
+    /// Samples it records.
+    pub samples: usize,
+}
+
+impl CampaignPlan {
+    /// The plan as JSON, keys sorted.
+    pub fn to_value(&self) -> serde_json::Value {
+        serde_json::to_value(self).expect("a plan is plain data")
+    }
+
+    /// Read a plan from JSON; an error names the missing or malformed key.
+    pub fn from_value(v: &serde_json::Value) -> Result<CampaignPlan, String> {
+        serde_path_to_error::deserialize(v)
+            .map_err(|e| format!("campaign.json: the plan: `{}`: {}", e.path(), e.inner()))
+    }
+
+    /// The run labelled `label`.
+    pub fn run(&self, label: &str) -> Result<&PlanRun, String> {
+        self.runs
+            .iter()
+            .find(|r| r.label == label)
+            .ok_or_else(|| format!("campaign.json: no run `{label}`"))
+    }
+}
