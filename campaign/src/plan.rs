@@ -15,33 +15,7 @@ use solver::element::precision::Precision;
 use solver::output::atomic::write_atomic;
 use std::collections::BTreeMap;
 use std::path::Path;
-
-/// Training or test location.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "lowercase")]
-pub enum Split {
-    /// Used for training (dataset split 0).
-    Train,
-    /// Held out (dataset split 1).
-    Test,
-}
-
-impl Split {
-    /// 0 for train, 1 for test.
-    pub fn code(self) -> u8 {
-        match self {
-            Split::Train => 0,
-            Split::Test => 1,
-        }
-    }
-    /// "train" or "test".
-    pub fn name(self) -> &'static str {
-        match self {
-            Split::Train => "train",
-            Split::Test => "test",
-        }
-    }
-}
+pub use surrogate::Split;
 
 /// One location of a campaign.
 #[derive(Clone, Debug, PartialEq)]

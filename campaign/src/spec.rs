@@ -330,6 +330,30 @@ impl CampaignSpec {
             vtk: false,
             ..Default::default()
         };
+        self.apply_phantom_and_hand(&mut base)?;
+        apply_solver(&self.solver, &mut base)?;
+        let (depths, timing, max_samples) = indentation(&self.indentation, &mut base)?;
+        let locations = resolve_locations(&self.locations)?;
+        let runs = plan_runs(&locations, &depths, &timing, &base, max_samples)?;
+        let c = Campaign {
+            title: self
+                .title
+                .clone()
+                .unwrap_or_else(|| "palpation campaign".into()),
+            base,
+            locations,
+            runs,
+        };
+        for r in &c.runs {
+            c.setup(r)
+                .validate()
+                .map_err(|e| format!("run {}: {e}", r.label))?;
+        }
+        Ok(c)
+    }
+
+    /// `[phantom]` and `[hand]` into the palpation settings.
+    fn apply_phantom_and_hand(&self, base: &mut PalpationSetup) -> Result<(), String> {
         let p = &self.phantom;
         if let Some(v) = &p.variant {
             v.parse::<phantom::Variant>()?;
@@ -355,208 +379,225 @@ impl CampaignSpec {
         if let Some(s) = self.hand.spacing {
             base.finger_spacing = s.0;
         }
-        let sv = &self.solver;
-        if let Some(e) = &sv.element {
-            base.element = e.parse::<ElementChoice>()?;
-        }
-        for (part, e) in sv.element_by_part.iter().flatten() {
-            let known =
-                phantom::PART_NAMES.contains(&part.as_str()) || phantom::is_tumour_part(part);
-            if !known {
-                return Err(format!(
-                    "solver.element_by_part: unknown part `{part}` ({}, tumour, tumour2, ...)",
-                    phantom::PART_NAMES.join(", ")
-                ));
-            }
-            let choice = e
-                .parse::<ElementChoice>()
-                .map_err(|m| format!("solver.element_by_part.{part}: {m}"))?;
-            base.part_elements.insert(part.clone(), choice);
-        }
-        base.max_bulk_ratio = sv.max_bulk_ratio.map(|r| r.0);
-        if let Some(f) = &sv.fidelity {
-            let fid = f
-                .parse::<scene::palpation::Fidelity>()
-                .map_err(|e| format!("solver.fidelity: {e}"))?;
-            if fid == scene::palpation::Fidelity::Fast
-                && (sv.element.is_some()
-                    || sv.element_by_part.is_some()
-                    || sv.max_bulk_ratio.is_some()
-                    || sv.precision.is_some())
-            {
-                return Err("solver.fidelity = \"fast\" sets the element, max_bulk_ratio and precision: give the preset or those keys".into());
-            }
-            fid.apply(&mut base);
-            base.fidelity = fid;
-        }
-        if let Some(p) = &sv.precision {
-            base.precision = solver::element::precision::Precision::parse(p)
-                .map_err(|e| format!("solver.precision: {e}"))?;
-        }
-        if let Some(f) = sv.dt_factor {
-            base.dt_factor = f.0;
-        }
-        if let Some(m) = &sv.mass_scaling {
-            base.mass_scaling = solver::model::StepTarget::parse_switch(m)
-                .map_err(|e| format!("solver.mass_scaling: {e}"))?;
-        }
-        if let Some(l) = sv.mass_scaling_limit {
-            base.mass_scaling_limit = l.0;
-        }
-        base.vtk = sv.vtk.unwrap_or(false);
-        let ind = &self.indentation;
-        if let Some(t) = ind.sample_interval {
-            base.sample_interval = t.0;
-            if !(t.0 > 0.0 && t.0.is_finite()) {
-                return Err(format!(
-                    "indentation.sample_interval must be a positive finite time, got {} s",
-                    t.0
-                ));
-            }
-        }
-        let max_samples = ind.max_samples.unwrap_or(DEFAULT_MAX_SAMPLES);
-        if !(max_samples >= 1.0 && max_samples.is_finite()) {
+        Ok(())
+    }
+}
+
+/// `[solver]` into the palpation settings: element (per part), the fidelity preset, precision,
+/// step factor, mass scaling and VTK output.
+fn apply_solver(sv: &SolverSpec, base: &mut PalpationSetup) -> Result<(), String> {
+    if let Some(e) = &sv.element {
+        base.element = e.parse::<ElementChoice>()?;
+    }
+    for (part, e) in sv.element_by_part.iter().flatten() {
+        let known = phantom::PART_NAMES.contains(&part.as_str()) || phantom::is_tumour_part(part);
+        if !known {
             return Err(format!(
-                "indentation.max_samples must be a positive finite count, got {max_samples}"
+                "solver.element_by_part: unknown part `{part}` ({}, tumour, tumour2, ...)",
+                phantom::PART_NAMES.join(", ")
             ));
         }
-        let depths: Vec<f64> = match &ind.depth {
-            Some(d) => d.0.iter().map(|x| x.0).collect(),
-            None => vec![base.depth],
-        };
-        if depths.is_empty() {
-            return Err("indentation.depth: the list is empty".into());
+        let choice = e
+            .parse::<ElementChoice>()
+            .map_err(|m| format!("solver.element_by_part.{part}: {m}"))?;
+        base.part_elements.insert(part.clone(), choice);
+    }
+    base.max_bulk_ratio = sv.max_bulk_ratio.map(|r| r.0);
+    if let Some(f) = &sv.fidelity {
+        let fid = f
+            .parse::<scene::palpation::Fidelity>()
+            .map_err(|e| format!("solver.fidelity: {e}"))?;
+        if fid == scene::palpation::Fidelity::Fast
+            && (sv.element.is_some()
+                || sv.element_by_part.is_some()
+                || sv.max_bulk_ratio.is_some()
+                || sv.precision.is_some())
+        {
+            return Err("solver.fidelity = \"fast\" sets the element, max_bulk_ratio and precision: give the preset or those keys".into());
         }
-        let mut timing: Vec<Box<dyn Fn(f64) -> f64>> = Vec::new();
-        match (&ind.duration, &ind.speed) {
-            (Some(_), Some(_)) => {
-                return Err("indentation: give `duration` or `speed`, not both".into());
-            }
-            (Some(d), None) => {
-                for t in &d.0 {
-                    let t = t.0;
-                    timing.push(Box::new(move |_| t));
-                }
-            }
-            (None, Some(s)) => {
-                for v in &s.0 {
-                    let v = v.0;
-                    if !(v > 0.0 && v.is_finite()) {
-                        return Err(format!("indentation.speed must be positive, got {v} m/s"));
-                    }
-                    timing.push(Box::new(move |depth| depth / v));
-                }
-            }
-            (None, None) => {
-                let t = base.duration;
+        fid.apply(base);
+        base.fidelity = fid;
+    }
+    if let Some(p) = &sv.precision {
+        base.precision = solver::element::precision::Precision::parse(p)
+            .map_err(|e| format!("solver.precision: {e}"))?;
+    }
+    if let Some(f) = sv.dt_factor {
+        base.dt_factor = f.0;
+    }
+    if let Some(m) = &sv.mass_scaling {
+        base.mass_scaling = solver::model::StepTarget::parse_switch(m)
+            .map_err(|e| format!("solver.mass_scaling: {e}"))?;
+    }
+    if let Some(l) = sv.mass_scaling_limit {
+        base.mass_scaling_limit = l.0;
+    }
+    base.vtk = sv.vtk.unwrap_or(false);
+    Ok(())
+}
+
+/// The time of an indentation to a depth (s).
+type Timing = Box<dyn Fn(f64) -> f64>;
+
+/// `[indentation]`: the sample interval (into `base`), the depths, the timings (a duration or a
+/// speed each) and the most samples a run may record.
+fn indentation(
+    ind: &IndentationSpec,
+    base: &mut PalpationSetup,
+) -> Result<(Vec<f64>, Vec<Timing>, f64), String> {
+    if let Some(t) = ind.sample_interval {
+        base.sample_interval = t.0;
+        if !(t.0 > 0.0 && t.0.is_finite()) {
+            return Err(format!(
+                "indentation.sample_interval must be a positive finite time, got {} s",
+                t.0
+            ));
+        }
+    }
+    let max_samples = ind.max_samples.unwrap_or(DEFAULT_MAX_SAMPLES);
+    if !(max_samples >= 1.0 && max_samples.is_finite()) {
+        return Err(format!(
+            "indentation.max_samples must be a positive finite count, got {max_samples}"
+        ));
+    }
+    let depths: Vec<f64> = match &ind.depth {
+        Some(d) => d.0.iter().map(|x| x.0).collect(),
+        None => vec![base.depth],
+    };
+    if depths.is_empty() {
+        return Err("indentation.depth: the list is empty".into());
+    }
+    let mut timing: Vec<Timing> = Vec::new();
+    match (&ind.duration, &ind.speed) {
+        (Some(_), Some(_)) => {
+            return Err("indentation: give `duration` or `speed`, not both".into());
+        }
+        (Some(d), None) => {
+            for t in &d.0 {
+                let t = t.0;
                 timing.push(Box::new(move |_| t));
             }
         }
-        if timing.is_empty() {
-            return Err("indentation: the list of durations or speeds is empty".into());
-        }
-
-        let l = &self.locations;
-        let default_train = vec![LocationEntry::Name("grid".into())];
-        let default_test: Vec<LocationEntry> = ["A", "B", "C"]
-            .iter()
-            .map(|n| LocationEntry::Name(n.to_string()))
-            .collect();
-        let mut locations = Vec::new();
-        let rasters: Vec<(Split, Vec<CampaignLocation>)> = l
-            .raster
-            .iter()
-            .map(raster_locations)
-            .collect::<Result<_, _>>()?;
-        for (split, entries) in [
-            (Split::Train, l.train.as_ref().unwrap_or(&default_train)),
-            (Split::Test, l.test.as_ref().unwrap_or(&default_test)),
-        ] {
-            for e in entries {
-                locations.extend(entry_locations(e, split)?);
-            }
-            for (s, r) in &rasters {
-                if *s == split {
-                    locations.extend(r.iter().cloned());
+        (None, Some(s)) => {
+            for v in &s.0 {
+                let v = v.0;
+                if !(v > 0.0 && v.is_finite()) {
+                    return Err(format!("indentation.speed must be positive, got {v} m/s"));
                 }
+                timing.push(Box::new(move |depth| depth / v));
             }
         }
-        if locations.is_empty() {
-            return Err("locations: the campaign has no locations".into());
+        (None, None) => {
+            let t = base.duration;
+            timing.push(Box::new(move |_| t));
         }
-        let mut seen = std::collections::HashSet::new();
-        for a in &locations {
-            if !seen.insert(a.label.as_str()) {
-                return Err(format!(
-                    "locations: `{}` appears twice (a location is either train or test, once)",
-                    a.label
-                ));
+    }
+    if timing.is_empty() {
+        return Err("indentation: the list of durations or speeds is empty".into());
+    }
+
+    Ok((depths, timing, max_samples))
+}
+
+/// `[locations]`: train entries, train rasters, test entries, test rasters, each label once.
+fn resolve_locations(l: &LocationsSpec) -> Result<Vec<CampaignLocation>, String> {
+    let default_train = vec![LocationEntry::Name("grid".into())];
+    let default_test: Vec<LocationEntry> = ["A", "B", "C"]
+        .iter()
+        .map(|n| LocationEntry::Name(n.to_string()))
+        .collect();
+    let mut locations = Vec::new();
+    let rasters: Vec<(Split, Vec<CampaignLocation>)> = l
+        .raster
+        .iter()
+        .map(raster_locations)
+        .collect::<Result<_, _>>()?;
+    for (split, entries) in [
+        (Split::Train, l.train.as_ref().unwrap_or(&default_train)),
+        (Split::Test, l.test.as_ref().unwrap_or(&default_test)),
+    ] {
+        for e in entries {
+            locations.extend(entry_locations(e, split)?);
+        }
+        for (s, r) in &rasters {
+            if *s == split {
+                locations.extend(r.iter().cloned());
             }
         }
-        let n_runs = locations
-            .len()
-            .saturating_mul(depths.len())
-            .saturating_mul(timing.len());
-        if n_runs > MAX_RUNS {
+    }
+    if locations.is_empty() {
+        return Err("locations: the campaign has no locations".into());
+    }
+    let mut seen = std::collections::HashSet::new();
+    for a in &locations {
+        if !seen.insert(a.label.as_str()) {
             return Err(format!(
-                "the campaign has {n_runs} runs ({} locations x {} depths x {} durations or speeds), more than the limit of {MAX_RUNS}",
-                locations.len(),
-                depths.len(),
-                timing.len()
+                "locations: `{}` appears twice (a location is either train or test, once)",
+                a.label
             ));
         }
+    }
+    Ok(locations)
+}
 
-        let several = depths.len() * timing.len() > 1;
-        let mut runs = Vec::new();
-        let mut labels = std::collections::HashSet::new();
-        for (li, loc) in locations.iter().enumerate() {
-            for &depth in &depths {
-                for tf in &timing {
-                    let duration = tf(depth);
-                    let samples = duration / base.sample_interval + 1.0;
-                    if samples.is_nan() || samples > max_samples {
-                        return Err(format!(
-                            "indentation.sample_interval: {:e} s over a duration of {:e} s gives {samples:.3e} samples a run, more than the limit of {max_samples:.0}; use a longer interval, or raise `indentation.max_samples` if you mean it",
-                            base.sample_interval, duration
-                        ));
-                    }
-                    let label = if several {
-                        format!(
-                            "{}_d{}mm_t{}ms",
-                            loc.label,
-                            short(depth * 1e3, 3),
-                            short(duration * 1e3, 3)
-                        )
-                    } else {
-                        loc.label.clone()
-                    };
-                    if !labels.insert(label.clone()) {
-                        return Err(format!("two runs would be labelled `{label}`: make the depths and durations distinct"));
-                    }
-                    runs.push(PlannedRun {
-                        index: runs.len(),
-                        label,
-                        location: li,
-                        depth,
-                        duration,
-                    });
+/// The runs: locations x depths x timings, in that order, within [`MAX_RUNS`] and the sample
+/// limit, each label once.
+fn plan_runs(
+    locations: &[CampaignLocation],
+    depths: &[f64],
+    timing: &[Timing],
+    base: &PalpationSetup,
+    max_samples: f64,
+) -> Result<Vec<PlannedRun>, String> {
+    let n_runs = locations
+        .len()
+        .saturating_mul(depths.len())
+        .saturating_mul(timing.len());
+    if n_runs > MAX_RUNS {
+        return Err(format!(
+            "the campaign has {n_runs} runs ({} locations x {} depths x {} durations or speeds), more than the limit of {MAX_RUNS}",
+            locations.len(),
+            depths.len(),
+            timing.len()
+        ));
+    }
+
+    let several = depths.len() * timing.len() > 1;
+    let mut runs = Vec::new();
+    let mut labels = std::collections::HashSet::new();
+    for (li, loc) in locations.iter().enumerate() {
+        for &depth in depths {
+            for tf in timing {
+                let duration = tf(depth);
+                let samples = duration / base.sample_interval + 1.0;
+                if samples.is_nan() || samples > max_samples {
+                    return Err(format!(
+                        "indentation.sample_interval: {:e} s over a duration of {:e} s gives {samples:.3e} samples a run, more than the limit of {max_samples:.0}; use a longer interval, or raise `indentation.max_samples` if you mean it",
+                        base.sample_interval, duration
+                    ));
                 }
+                let label = if several {
+                    format!(
+                        "{}_d{}mm_t{}ms",
+                        loc.label,
+                        short(depth * 1e3, 3),
+                        short(duration * 1e3, 3)
+                    )
+                } else {
+                    loc.label.clone()
+                };
+                if !labels.insert(label.clone()) {
+                    return Err(format!("two runs would be labelled `{label}`: make the depths and durations distinct"));
+                }
+                runs.push(PlannedRun {
+                    index: runs.len(),
+                    label,
+                    location: li,
+                    depth,
+                    duration,
+                });
             }
         }
-        let c = Campaign {
-            title: self
-                .title
-                .clone()
-                .unwrap_or_else(|| "palpation campaign".into()),
-            base,
-            locations,
-            runs,
-        };
-        for r in &c.runs {
-            c.setup(r)
-                .validate()
-                .map_err(|e| format!("run {}: {e}", r.label))?;
-        }
-        Ok(c)
     }
+    Ok(runs)
 }

@@ -14,6 +14,7 @@ use contact::{
 };
 use solver::contact_stage::ContactForceStage;
 use solver::mesh::Mesh;
+use solver::model::Model;
 use solver::simulation::Simulation;
 use std::collections::HashSet;
 use std::path::Path;
@@ -338,8 +339,74 @@ pub fn build_stage(
     }
     let hands = std::mem::take(&mut contact.hands);
 
-    // Surface.
     let model = &sim.model;
+    let mesh = &model.mesh;
+    let surface = contact_surface(model, contact)?;
+
+    // Initial penetration: a hand without an explicit `gap` whose fingertips start inside the
+    // surface (a curved skin under two fingers) is backed off until they just touch it; a hand
+    // placed on a phantom location then travels that much further, so that its indentation
+    // beyond first contact is the requested one. Any other indenter that starts inside the
+    // surface by more than 5 % of its feature size is an error that names it.
+    let design_dt = (sim.settings.dt_factor * model.scaled_dt).min(sim.settings.dt_max);
+    let mut params = contact.params.clone();
+    if params.design_dt.is_none() {
+        params.design_dt = Some(design_dt);
+    }
+    let backing = BackOff {
+        sim,
+        surface: &surface,
+        params: &params,
+        design_dt,
+        path,
+    };
+    let gaps = backing.gaps(&mut specs, &hands, &origins, contact.indenters.len())?;
+    let n_ind = contact.indenters.len();
+    for (k, h) in hands.iter().enumerate() {
+        let gap = gaps[k];
+        if gap <= 0.0 {
+            continue;
+        }
+        if h.placed {
+            if let MotionSpec::Displacement { curve } = &mut specs[n_ind + k].motion {
+                if let Curve::SmoothStep { amplitude, .. } | Curve::Ramp { amplitude, .. } = curve {
+                    *amplitude += gap;
+                }
+            }
+        }
+        notes.push(format!(
+            "hand `{}`: the fingertips started {:.3} mm inside the contact surface; backed off by that much{}",
+            h.hand.name,
+            gap * 1e3,
+            if h.placed {
+                " and the travel extended to match"
+            } else {
+                " (set `gap` to choose)"
+            }
+        ));
+    }
+    let faces = surface.faces.clone();
+    let stage = ContactStage::new(&specs, surface, &mesh.nodes, &model.mass, params)
+        .map_err(|e| format!("{}: {e}", path.display()))?;
+    let st = ContactForceStage::new(
+        stage,
+        &specs,
+        faces,
+        mesh.nodes.len(),
+        sim.settings.dt_factor,
+    );
+    contact.indenters = specs
+        .into_iter()
+        .zip(origins)
+        .map(|(spec, origin)| IndenterDef { spec, origin })
+        .collect();
+    Ok(st)
+}
+
+/// The contact surface of `contact`'s selection: the mesh boundary faces of the selected parts
+/// whose nodes all lie in the selected node set (and, from a deck, among the selected faces),
+/// each with its element's P-wave modulus and reference volume.
+fn contact_surface(model: &Model, contact: &ContactDef) -> Result<ContactSurface, String> {
     let mesh = &model.mesh;
     let sel = &contact.surface;
     let mut vol = vec![0.0; mesh.elements.len()];
@@ -387,100 +454,77 @@ pub fn build_stage(
         ));
     }
 
-    // Initial penetration: a hand without an explicit `gap` whose fingertips start inside the
-    // surface (a curved skin under two fingers) is backed off until they just touch it; a hand
-    // placed on a phantom location then travels that much further, so that its indentation
-    // beyond first contact is the requested one. Any other indenter that starts inside the
-    // surface by more than 5 % of its feature size is an error that names it.
-    let design_dt = (sim.settings.dt_factor * model.scaled_dt).min(sim.settings.dt_max);
-    let mut params = contact.params.clone();
-    if params.design_dt.is_none() {
-        params.design_dt = Some(design_dt);
-    }
-    // Largest penetration of each indenter at t = 0 over the face samples, as the stage sees it.
-    let zeros = vec![[0.0; 3]; mesh.nodes.len()];
-    let measure = |specs: &[IndenterSpec]| -> Result<Vec<f64>, String> {
+    Ok(surface)
+}
+
+/// What backing hands off the skin needs: the model, the surface and the stage's parameters.
+struct BackOff<'a> {
+    sim: &'a Simulation,
+    surface: &'a ContactSurface,
+    params: &'a ContactParams,
+    design_dt: f64,
+    path: &'a Path,
+}
+
+impl BackOff<'_> {
+    /// Largest penetration of each indenter at t = 0 over the face samples, as the stage sees it.
+    fn penetrations(&self, specs: &[IndenterSpec]) -> Result<Vec<f64>, String> {
+        let mesh = &self.sim.model.mesh;
+        let zeros = vec![[0.0; 3]; mesh.nodes.len()];
         let mut st = ContactStage::new(
             specs,
-            surface.clone(),
+            self.surface.clone(),
             &mesh.nodes,
-            &model.mass,
-            params.clone(),
+            &self.sim.model.mass,
+            self.params.clone(),
         )
-        .map_err(|e| format!("{}: {e}", path.display()))?;
+        .map_err(|e| format!("{}: {e}", self.path.display()))?;
         let mut f = zeros.clone();
-        st.apply(0.0, design_dt, &mesh.nodes, &zeros, &mut f);
+        st.apply(0.0, self.design_dt, &mesh.nodes, &zeros, &mut f);
         Ok(st.indenters().iter().map(|s| s.max_penetration).collect())
-    };
-    let n_ind = contact.indenters.len();
-    let mut gaps = vec![0.0; hands.len()];
-    for _ in 0..20 {
-        let pens = measure(&specs)?;
-        let mut moved = false;
-        for (k, h) in hands.iter().enumerate() {
-            if !h.gap_given && pens[n_ind + k] > 1e-9 {
-                gaps[k] += pens[n_ind + k] + 1e-7;
-                let mut hs = h.hand.clone();
-                hs.gap = gaps[k];
-                specs[n_ind + k] = hs
-                    .to_indenter_spec()
-                    .map_err(|e| format!("{}: `hand`: {e}", h.origin))?;
-                moved = true;
-            }
-        }
-        if !moved {
-            for ((spec, pen), origin) in specs.iter().zip(&pens).zip(&origins) {
-                let size = contact::Indenter::from_spec(spec)
-                    .map(|i| i.feature_size())
-                    .unwrap_or(f64::INFINITY);
-                if *pen > 0.05 * size {
-                    return Err(format!(
-                        "{origin}: `indenter`: `{}` starts {:.3} mm inside the contact surface; move it out (or give a hand no `gap`, and palpa backs it off)",
-                        spec.name,
-                        pen * 1e3
-                    ));
+    }
+
+    /// Back each hand without a `gap` off until it just touches the surface (`specs[n_ind + k]`
+    /// is hand `k`); returns each hand's gap (m). Any other indenter that starts inside the
+    /// surface by more than 5 % of its feature size is an error that names it.
+    fn gaps(
+        &self,
+        specs: &mut [IndenterSpec],
+        hands: &[HandDef],
+        origins: &[String],
+        n_ind: usize,
+    ) -> Result<Vec<f64>, String> {
+        let mut gaps = vec![0.0; hands.len()];
+        for _ in 0..20 {
+            let pens = self.penetrations(specs)?;
+            let mut moved = false;
+            for (k, h) in hands.iter().enumerate() {
+                if !h.gap_given && pens[n_ind + k] > 1e-9 {
+                    gaps[k] += pens[n_ind + k] + 1e-7;
+                    let mut hs = h.hand.clone();
+                    hs.gap = gaps[k];
+                    specs[n_ind + k] = hs
+                        .to_indenter_spec()
+                        .map_err(|e| format!("{}: `hand`: {e}", h.origin))?;
+                    moved = true;
                 }
             }
-            break;
-        }
-    }
-    for (k, h) in hands.iter().enumerate() {
-        let gap = gaps[k];
-        if gap <= 0.0 {
-            continue;
-        }
-        if h.placed {
-            if let MotionSpec::Displacement { curve } = &mut specs[n_ind + k].motion {
-                if let Curve::SmoothStep { amplitude, .. } | Curve::Ramp { amplitude, .. } = curve {
-                    *amplitude += gap;
+            if !moved {
+                for ((spec, pen), origin) in specs.iter().zip(&pens).zip(origins) {
+                    let size = contact::Indenter::from_spec(spec)
+                        .map(|i| i.feature_size())
+                        .unwrap_or(f64::INFINITY);
+                    if *pen > 0.05 * size {
+                        return Err(format!(
+                            "{origin}: `indenter`: `{}` starts {:.3} mm inside the contact surface; move it out (or give a hand no `gap`, and palpa backs it off)",
+                            spec.name,
+                            pen * 1e3
+                        ));
+                    }
                 }
+                break;
             }
         }
-        notes.push(format!(
-            "hand `{}`: the fingertips started {:.3} mm inside the contact surface; backed off by that much{}",
-            h.hand.name,
-            gap * 1e3,
-            if h.placed {
-                " and the travel extended to match"
-            } else {
-                " (set `gap` to choose)"
-            }
-        ));
+        Ok(gaps)
     }
-    let faces = surface.faces.clone();
-    let stage = ContactStage::new(&specs, surface, &mesh.nodes, &model.mass, params)
-        .map_err(|e| format!("{}: {e}", path.display()))?;
-    let st = ContactForceStage::new(
-        stage,
-        &specs,
-        faces,
-        mesh.nodes.len(),
-        sim.settings.dt_factor,
-    );
-    contact.indenters = specs
-        .into_iter()
-        .zip(origins)
-        .map(|(spec, origin)| IndenterDef { spec, origin })
-        .collect();
-    Ok(st)
 }

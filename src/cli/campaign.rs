@@ -152,23 +152,7 @@ fn run_campaign(a: &CampaignArgs) -> Result<(), String> {
     let n_done = done.iter().filter(|&&d| d).count();
 
     if !a.quiet || a.dry_run {
-        println!(
-            "campaign `{}`: {} runs ({} locations: {} train, {} test){}; phantom {} voxel {:.1} mm: {} hexahedra, ROI {} elements, built in {:.2} s",
-            campaign.title,
-            campaign.runs.len(),
-            campaign.locations.len(),
-            campaign.locations.iter().filter(|l| l.split == Split::Train).count(),
-            campaign.locations.iter().filter(|l| l.split == Split::Test).count(),
-            match shard {
-                Some((i, n)) => format!(", shard {i}/{n}: {} runs", mine.len()),
-                None => String::new(),
-            },
-            campaign.base.variant,
-            campaign.base.voxel * 1e3,
-            phantom.mesh.elements.len(),
-            phantom.roi.elements.len(),
-            build_s
-        );
+        print_header(&campaign, &phantom, shard, mine.len(), build_s);
     }
     if a.dry_run {
         print_plan(&campaign, &locs, &mine, &done);
@@ -278,6 +262,33 @@ fn finish(
         print_dataset(&ds, out, sharded);
     }
     Ok(())
+}
+
+/// The campaign's first line: runs, locations, shard, phantom and its build time.
+fn print_header(
+    campaign: &Campaign,
+    phantom: &Phantom,
+    shard: Option<(usize, usize)>,
+    n_mine: usize,
+    build_s: f64,
+) {
+    println!(
+        "campaign `{}`: {} runs ({} locations: {} train, {} test){}; phantom {} voxel {:.1} mm: {} hexahedra, ROI {} elements, built in {:.2} s",
+        campaign.title,
+        campaign.runs.len(),
+        campaign.locations.len(),
+        campaign.locations.iter().filter(|l| l.split == Split::Train).count(),
+        campaign.locations.iter().filter(|l| l.split == Split::Test).count(),
+        match shard {
+            Some((i, n)) => format!(", shard {i}/{n}: {n_mine} runs"),
+            None => String::new(),
+        },
+        campaign.base.variant,
+        campaign.base.voxel * 1e3,
+        phantom.mesh.elements.len(),
+        phantom.roi.elements.len(),
+        build_s
+    );
 }
 
 fn print_plan(c: &Campaign, locs: &[phantom::Location], mine: &[&PlannedRun], done: &[bool]) {
@@ -390,7 +401,7 @@ fn execute_with_progress(
 }
 
 fn print_dataset(ds: &Dataset, out: &Path, partial: bool) {
-    let train = ds.rows_with_split(0).len();
+    let train = ds.rows_with_split(surrogate::Split::Train).len();
     let (lo, hi) =
         ds.y.iter()
             .fold((f64::INFINITY, f64::NEG_INFINITY), |a, &v| {

@@ -206,8 +206,8 @@ fn fit_and_score(
     opts: &TrainOptions,
 ) -> Result<(TrainedModel, TrainReport, Array2<f64>)> {
     data.validate()?;
-    let train_rows = data.rows_with_split(0);
-    let test_rows = data.rows_with_split(1);
+    let train_rows = data.rows_with_split(crate::Split::Train);
+    let test_rows = data.rows_with_split(crate::Split::Test);
     if train_rows.is_empty() {
         return Err(Error::invalid("split", "no training samples (split == 0)"));
     }

@@ -127,10 +127,10 @@ impl Dataset {
         self.y.ncols()
     }
 
-    /// Row indices of the training (split 0) or test (split 1) samples.
-    pub fn rows_with_split(&self, split: u8) -> Vec<usize> {
+    /// Row indices of the training or test samples.
+    pub fn rows_with_split(&self, split: crate::Split) -> Vec<usize> {
         (0..self.n_samples())
-            .filter(|&i| self.split[i] == split)
+            .filter(|&i| self.split[i] == split.code())
             .collect()
     }
 

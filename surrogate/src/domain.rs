@@ -97,7 +97,7 @@ impl std::fmt::Display for Outside {
 impl TrainingDomain {
     /// The domain of `data`'s training rows (split 0); `None` without training rows.
     pub fn of_training_rows(data: &Dataset) -> Option<TrainingDomain> {
-        let rows = data.rows_with_split(0);
+        let rows = data.rows_with_split(crate::Split::Train);
         if rows.is_empty() {
             return None;
         }
@@ -187,7 +187,7 @@ mod tests {
         assert_eq!(d.locations.len(), 25);
         assert_eq!(d.hull.len(), 4, "{:?}", d.hull);
         let fmax = data
-            .rows_with_split(0)
+            .rows_with_split(crate::Split::Train)
             .iter()
             .map(|&i| data.x[(i, 2)])
             .fold(0.0, f64::max);

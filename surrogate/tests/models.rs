@@ -49,11 +49,11 @@ fn gp_options() -> TrainOptions {
 #[test]
 fn location_blind_baseline_scores_below_threshold() {
     let d = make_synthetic_dataset(R);
-    let test = d.rows_with_split(1);
+    let test = d.rows_with_split(surrogate::Split::Test);
     let mut yhat = d.y.select(Axis(0), &test);
     for (k, &i) in test.iter().enumerate() {
         let same_force: Vec<usize> = d
-            .rows_with_split(0)
+            .rows_with_split(surrogate::Split::Train)
             .into_iter()
             .filter(|&j| d.x[(j, 2)] == d.x[(i, 2)])
             .collect();
@@ -186,7 +186,7 @@ fn gp_on_the_stress_tensor_serves_the_largest_eigenvalue_of_its_prediction() {
     assert!(report.test_fit.unwrap() > FLOOR, "{report}");
     let mut raw = model.to_predictor();
     let mut map = TargetMap::new(Target::Tensor, R);
-    for i in d.rows_with_split(1) {
+    for i in d.rows_with_split(surrogate::Split::Test) {
         let s6 = raw
             .predict_inputs(&[d.x[(i, 0)], d.x[(i, 1)], d.x[(i, 2)]])
             .to_vec();
@@ -414,7 +414,7 @@ fn gp_with_repeated_unloaded_rows_and_noisy_targets_keeps_a_noise_term() {
     let mut d = make_synthetic_dataset(R);
     // the noise goes on Y; without S the GP's default target is Y
     d.stress = None;
-    let train = d.rows_with_split(0);
+    let train = d.rows_with_split(surrogate::Split::Train);
     let rms = (train
         .iter()
         .map(|&i| d.y.row(i).iter().map(|v| v * v).sum::<f64>())

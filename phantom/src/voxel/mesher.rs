@@ -138,74 +138,17 @@ pub fn build_hexes(
     interfaces: bool,
 ) -> Result<(Mesh, Vec<SurfaceFace>, Vec<u8>), String> {
     let [nx, ny, nz] = v.dims;
-    let (gx, gy) = (nx + 1, ny + 1);
-    let gid = |a: usize, b: usize, c: usize| a + gx * (b + gy * c);
-    let n_grid = gx * gy * (nz + 1);
+    let grid = Grid {
+        gx: nx + 1,
+        gy: ny + 1,
+    };
+    let n_grid = grid.gx * grid.gy * (nz + 1);
     if n_grid > u32::MAX as usize {
         return Err("volume too large for 32-bit node ids".into());
     }
     let part_of = |l: u8| table[l as usize];
-    // mark used vertices, k-slab by k-slab
-    let mut used = vec![false; n_grid];
-    for k in 0..nz {
-        for j in 0..ny {
-            for i in 0..nx {
-                if part_of(v.get(i, j, k)) != u32::MAX {
-                    for c in 0..2 {
-                        for b in 0..2 {
-                            for a in 0..2 {
-                                used[gid(i + a, j + b, k + c)] = true;
-                            }
-                        }
-                    }
-                }
-            }
-        }
-    }
-    let mut node_id = vec![u32::MAX; n_grid];
-    let mut nodes = Vec::new();
-    let mut plane_bits = Vec::new();
-    for c in 0..=nz {
-        for b in 0..=ny {
-            for a in 0..=nx {
-                let g = gid(a, b, c);
-                if used[g] {
-                    node_id[g] = nodes.len() as u32;
-                    nodes.push(v.index_to_world([a as f64 - 0.5, b as f64 - 0.5, c as f64 - 0.5]));
-                    let bits = (a == 0 || a == nx) as u8
-                        | (((b == 0 || b == ny) as u8) << 1)
-                        | (((c == 0 || c == nz) as u8) << 2);
-                    plane_bits.push(bits);
-                }
-            }
-        }
-    }
-    drop(used);
-    let mirrored = v.affine_det() < 0.0;
-    // VTK order: (0,0,0) (1,0,0) (1,1,0) (0,1,0) then c = 1
-    let order: [[usize; 3]; 8] = if mirrored {
-        [
-            [1, 0, 0],
-            [0, 0, 0],
-            [0, 1, 0],
-            [1, 1, 0],
-            [1, 0, 1],
-            [0, 0, 1],
-            [0, 1, 1],
-            [1, 1, 1],
-        ]
-    } else {
-        [
-            [0, 0, 0],
-            [1, 0, 0],
-            [1, 1, 0],
-            [0, 1, 0],
-            [0, 0, 1],
-            [1, 0, 1],
-            [1, 1, 1],
-            [0, 1, 1],
-        ]
-    };
+    let (node_id, nodes, plane_bits) = grid_nodes(v, &grid, n_grid, &part_of);
+    let order = corner_order(v.affine_det() < 0.0);
     let mut elements = Vec::new();
     let mut element_part = Vec::new();
     let mut faces = Vec::new();
@@ -218,44 +161,18 @@ pub fn build_hexes(
                 }
                 let mut conn = [0u32; 8];
                 for (q, o) in order.iter().enumerate() {
-                    conn[q] = node_id[gid(i + o[0], j + o[1], k + o[2])];
+                    conn[q] = node_id[grid.id(i + o[0], j + o[1], k + o[2])];
                 }
                 elements.push(conn);
                 element_part.push(p);
-                // faces towards the 6 neighbours
-                for ax in 0..3 {
-                    for side in 0..2usize {
-                        let mut nb = [i as isize, j as isize, k as isize];
-                        nb[ax] += if side == 0 { -1 } else { 1 };
-                        let outside = nb[ax] < 0 || nb[ax] >= v.dims[ax] as isize;
-                        let q = if outside {
-                            u32::MAX
-                        } else {
-                            part_of(v.get_or_bg(nb[0], nb[1], nb[2]))
-                        };
-                        let patch = if outside {
-                            // cut plane: its own patch per (part, plane)
-                            ((p as u64) << 32) | (0xFFFF_0000 + (ax * 2 + side) as u64)
-                        } else if q == u32::MAX {
-                            ((p as u64) << 32) | 0xFFFF_FFFF
-                        } else if q != p && interfaces && p < q {
-                            ((p as u64) << 32) | q as u64
-                        } else {
-                            continue;
-                        };
-                        let mut base = [i, j, k];
-                        base[ax] += side;
-                        let mut fnodes = [0u32; 4];
-                        for (r, off) in FACE_CYCLES[ax].iter().enumerate() {
-                            fnodes[r] =
-                                node_id[gid(base[0] + off[0], base[1] + off[1], base[2] + off[2])];
-                        }
-                        faces.push(SurfaceFace {
-                            nodes: fnodes,
-                            patch,
-                        });
-                    }
-                }
+                let faces_of = VoxelFaces {
+                    v,
+                    grid: &grid,
+                    node_id: &node_id,
+                    part_of: &part_of,
+                    interfaces,
+                };
+                faces_of.push([i, j, k], p, &mut faces);
             }
         }
     }
@@ -282,4 +199,145 @@ pub fn build_hexes(
     }
     mesh.node_sets.insert("surface".into(), surf);
     Ok((mesh, faces, plane_bits))
+}
+
+/// The grid of voxel corners: `gx` x `gy` x (nz + 1) points, x fastest.
+struct Grid {
+    gx: usize,
+    gy: usize,
+}
+
+impl Grid {
+    fn id(&self, a: usize, b: usize, c: usize) -> usize {
+        a + self.gx * (b + self.gy * c)
+    }
+}
+
+/// The corners used by some element, numbered in grid order: the grid-to-node map, the node
+/// positions (the voxel centres' world frame) and each node's bounding-plane bits.
+fn grid_nodes(
+    v: &LabelVolume,
+    grid: &Grid,
+    n_grid: usize,
+    part_of: &impl Fn(u8) -> u32,
+) -> (Vec<u32>, Vec<[f64; 3]>, Vec<u8>) {
+    let [nx, ny, nz] = v.dims;
+    // mark used vertices, k-slab by k-slab
+    let mut used = vec![false; n_grid];
+    for k in 0..nz {
+        for j in 0..ny {
+            for i in 0..nx {
+                if part_of(v.get(i, j, k)) != u32::MAX {
+                    for c in 0..2 {
+                        for b in 0..2 {
+                            for a in 0..2 {
+                                used[grid.id(i + a, j + b, k + c)] = true;
+                            }
+                        }
+                    }
+                }
+            }
+        }
+    }
+    let mut node_id = vec![u32::MAX; n_grid];
+    let mut nodes = Vec::new();
+    let mut plane_bits = Vec::new();
+    for c in 0..=nz {
+        for b in 0..=ny {
+            for a in 0..=nx {
+                let g = grid.id(a, b, c);
+                if used[g] {
+                    node_id[g] = nodes.len() as u32;
+                    nodes.push(v.index_to_world([a as f64 - 0.5, b as f64 - 0.5, c as f64 - 0.5]));
+                    let bits = (a == 0 || a == nx) as u8
+                        | (((b == 0 || b == ny) as u8) << 1)
+                        | (((c == 0 || c == nz) as u8) << 2);
+                    plane_bits.push(bits);
+                }
+            }
+        }
+    }
+    (node_id, nodes, plane_bits)
+}
+
+/// A voxel's corners in VTK order: (0,0,0) (1,0,0) (1,1,0) (0,1,0) then c = 1; mirrored when
+/// the volume's affine map reverses orientation, so that every element has positive volume.
+fn corner_order(mirrored: bool) -> [[usize; 3]; 8] {
+    if mirrored {
+        [
+            [1, 0, 0],
+            [0, 0, 0],
+            [0, 1, 0],
+            [1, 1, 0],
+            [1, 0, 1],
+            [0, 0, 1],
+            [0, 1, 1],
+            [1, 1, 1],
+        ]
+    } else {
+        [
+            [0, 0, 0],
+            [1, 0, 0],
+            [1, 1, 0],
+            [0, 1, 0],
+            [0, 0, 1],
+            [1, 0, 1],
+            [1, 1, 1],
+            [0, 1, 1],
+        ]
+    }
+}
+
+/// The surface faces of a voxel towards its six neighbours.
+struct VoxelFaces<'a, P: Fn(u8) -> u32> {
+    v: &'a LabelVolume,
+    grid: &'a Grid,
+    node_id: &'a [u32],
+    part_of: &'a P,
+    interfaces: bool,
+}
+
+impl<P: Fn(u8) -> u32> VoxelFaces<'_, P> {
+    /// Push the faces of voxel `[i, j, k]` (part `p`) that lie on the outer surface, on a cut
+    /// plane or (with `interfaces`) on an interface towards a part of higher index, each with
+    /// its patch key.
+    fn push(&self, [i, j, k]: [usize; 3], p: u32, faces: &mut Vec<SurfaceFace>) {
+        let v = self.v;
+        for ax in 0..3 {
+            for side in 0..2usize {
+                let mut nb = [i as isize, j as isize, k as isize];
+                nb[ax] += if side == 0 { -1 } else { 1 };
+                let outside = nb[ax] < 0 || nb[ax] >= v.dims[ax] as isize;
+                let q = if outside {
+                    u32::MAX
+                } else {
+                    (self.part_of)(v.get_or_bg(nb[0], nb[1], nb[2]))
+                };
+                let patch = if outside {
+                    // cut plane: its own patch per (part, plane)
+                    ((p as u64) << 32) | (0xFFFF_0000 + (ax * 2 + side) as u64)
+                } else if q == u32::MAX {
+                    ((p as u64) << 32) | 0xFFFF_FFFF
+                } else if q != p && self.interfaces && p < q {
+                    ((p as u64) << 32) | q as u64
+                } else {
+                    continue;
+                };
+                let mut base = [i, j, k];
+                base[ax] += side;
+                let mut fnodes = [0u32; 4];
+                for (r, off) in FACE_CYCLES[ax].iter().enumerate() {
+                    fnodes[r] = self.node_id[self.grid.id(
+                        base[0] + off[0],
+                        base[1] + off[1],
+                        base[2] + off[2],
+                    )];
+                }
+                faces.push(SurfaceFace {
+                    nodes: fnodes,
+                    patch,
+                });
+            }
+        }
+    }
 }

@@ -120,39 +120,7 @@ pub fn smooth_surfaces(
     if opts.iterations == 0 || faces.is_empty() {
         return report;
     }
-    // patch sets and edge neighbours
-    let mut np = Vec::with_capacity(faces.len() * 4);
-    let mut ne = Vec::with_capacity(faces.len() * 8);
-    for f in faces {
-        for a in 0..4 {
-            let (v, u, w) = (f.nodes[a], f.nodes[(a + 1) % 4], f.nodes[(a + 3) % 4]);
-            np.push((v, f.patch));
-            ne.push((v, u as u64));
-            ne.push((v, w as u64));
-        }
-    }
-    let (ps, pv) = csr_from_pairs(n, np);
-    let (es, ev) = csr_from_pairs(n, ne);
-    let patches = |v: usize| &pv[ps[v]..ps[v + 1]];
-    // admissible neighbours: P(u) contains P(v) (both sorted)
-    let contains = |big: &[u64], small: &[u64]| small.iter().all(|s| big.binary_search(s).is_ok());
-    let adm: Vec<(u32, Vec<u32>)> = (0..n)
-        .into_par_iter()
-        .filter(|&v| ps[v + 1] > ps[v])
-        .filter_map(|v| {
-            let pvv = patches(v);
-            let list: Vec<u32> = ev[es[v]..es[v + 1]]
-                .iter()
-                .map(|&u| u as u32)
-                .filter(|&u| contains(patches(u as usize), pvv))
-                .collect();
-            if list.is_empty() {
-                None
-            } else {
-                Some((v as u32, list))
-            }
-        })
-        .collect();
+    let adm = admissible_neighbours(n, faces);
     report.movable_nodes = adm.len();
     let mut movable = vec![false; n];
     for (v, _) in &adm {
@@ -175,94 +143,27 @@ pub fn smooth_surfaces(
         .par_iter()
         .map(|&e| min_scaled_jacobian(&element_coords(nodes, &elements[e as usize])))
         .reduce(|| f64::INFINITY, f64::min);
-    let thr = opts.min_scaled_jacobian.min(0.9 * init_min);
-    let lmin: Vec<f64> = candidates
-        .par_iter()
-        .map(|&e| {
-            opts.min_length_ratio
-                * characteristic_length(&element_coords(nodes, &elements[e as usize]))
-        })
-        .collect();
+    let guard = Guard {
+        elements,
+        candidates: &candidates,
+        lmin: candidates
+            .par_iter()
+            .map(|&e| {
+                opts.min_length_ratio
+                    * characteristic_length(&element_coords(nodes, &elements[e as usize]))
+            })
+            .collect(),
+        thr: opts.min_scaled_jacobian.min(0.9 * init_min),
+        slot: &slot,
+    };
     for _ in 0..opts.iterations {
         for &f in &[opts.lambda, opts.mu] {
             let old: Vec<[f64; 3]> = adm.iter().map(|(v, _)| nodes[*v as usize]).collect();
-            let snap: &[[f64; 3]] = nodes;
-            let target: Vec<[f64; 3]> = adm
-                .par_iter()
-                .map(|(v, list)| {
-                    let x = snap[*v as usize];
-                    let mut m = [0.0; 3];
-                    for &u in list {
-                        for k in 0..3 {
-                            m[k] += snap[u as usize][k];
-                        }
-                    }
-                    let inv = 1.0 / list.len() as f64;
-                    let mut d = [
-                        f * (m[0] * inv - x[0]),
-                        f * (m[1] * inv - x[1]),
-                        f * (m[2] * inv - x[2]),
-                    ];
-                    let bits = plane_bits[*v as usize];
-                    for (b, nrm) in normals.iter().enumerate() {
-                        if bits & (1 << b) != 0 {
-                            let dn = d[0] * nrm[0] + d[1] * nrm[1] + d[2] * nrm[2];
-                            for k in 0..3 {
-                                d[k] -= dn * nrm[k];
-                            }
-                        }
-                    }
-                    [x[0] + d[0], x[1] + d[1], x[2] + d[2]]
-                })
-                .collect();
+            let target = half_step(nodes, &adm, f, plane_bits, normals);
             for (q, (v, _)) in adm.iter().enumerate() {
                 nodes[*v as usize] = target[q];
             }
-            // back off where elements became poor
-            let mut scale = vec![1.0f64; adm.len()];
-            for round in 0.. {
-                let snap: &[[f64; 3]] = nodes;
-                let bad: Vec<u32> = candidates
-                    .par_iter()
-                    .zip(lmin.par_iter())
-                    .filter(|&(&e, &lm)| {
-                        let x = element_coords(snap, &elements[e as usize]);
-                        min_scaled_jacobian(&x) < thr || characteristic_length(&x) < lm
-                    })
-                    .map(|(&e, _)| e)
-                    .collect();
-                if bad.is_empty() {
-                    break;
-                }
-                let mut hit = vec![false; adm.len()];
-                for &e in &bad {
-                    for &v in &elements[e as usize] {
-                        let q = slot[v as usize];
-                        if q != u32::MAX {
-                            hit[q as usize] = true;
-                        }
-                    }
-                }
-                for (q, (v, _)) in adm.iter().enumerate() {
-                    if !hit[q] || scale[q] == 0.0 {
-                        continue;
-                    }
-                    if round >= 3 {
-                        scale[q] = 0.0;
-                        report.reverted += 1;
-                    } else {
-                        scale[q] *= 0.5;
-                        report.backoffs += 1;
-                    }
-                    let s = scale[q];
-                    let (o, t) = (old[q], target[q]);
-                    nodes[*v as usize] = [
-                        o[0] + s * (t[0] - o[0]),
-                        o[1] + s * (t[1] - o[1]),
-                        o[2] + s * (t[2] - o[2]),
-                    ];
-                }
-            }
+            guard.back_off(nodes, &adm, &old, &target, &mut report);
             report.half_steps += 1;
         }
     }
@@ -280,4 +181,151 @@ pub fn smooth_surfaces(
         report.mean_displacement = sum / adm.len() as f64;
     }
     report
+}
+
+/// The movable nodes with their admissible neighbours: edge neighbours `u` on the surface whose
+/// patch set contains the node's (a node on a patch edge moves only along that edge).
+fn admissible_neighbours(n: usize, faces: &[SurfaceFace]) -> Vec<(u32, Vec<u32>)> {
+    // patch sets and edge neighbours
+    let mut np = Vec::with_capacity(faces.len() * 4);
+    let mut ne = Vec::with_capacity(faces.len() * 8);
+    for f in faces {
+        for a in 0..4 {
+            let (v, u, w) = (f.nodes[a], f.nodes[(a + 1) % 4], f.nodes[(a + 3) % 4]);
+            np.push((v, f.patch));
+            ne.push((v, u as u64));
+            ne.push((v, w as u64));
+        }
+    }
+    let (ps, pv) = csr_from_pairs(n, np);
+    let (es, ev) = csr_from_pairs(n, ne);
+    let patches = |v: usize| &pv[ps[v]..ps[v + 1]];
+    // admissible neighbours: P(u) contains P(v) (both sorted)
+    let contains = |big: &[u64], small: &[u64]| small.iter().all(|s| big.binary_search(s).is_ok());
+    (0..n)
+        .into_par_iter()
+        .filter(|&v| ps[v + 1] > ps[v])
+        .filter_map(|v| {
+            let pvv = patches(v);
+            let list: Vec<u32> = ev[es[v]..es[v + 1]]
+                .iter()
+                .map(|&u| u as u32)
+                .filter(|&u| contains(patches(u as usize), pvv))
+                .collect();
+            if list.is_empty() {
+                None
+            } else {
+                Some((v as u32, list))
+            }
+        })
+        .collect()
+}
+
+/// One Taubin half step with factor `f` (lambda or mu): each movable node moves `f` times the
+/// way to its neighbours' mean, less the components along the normals of its bounding planes.
+fn half_step(
+    nodes: &[[f64; 3]],
+    adm: &[(u32, Vec<u32>)],
+    f: f64,
+    plane_bits: &[u8],
+    normals: &[[f64; 3]; 3],
+) -> Vec<[f64; 3]> {
+    adm.par_iter()
+        .map(|(v, list)| {
+            let x = nodes[*v as usize];
+            let mut m = [0.0; 3];
+            for &u in list {
+                for k in 0..3 {
+                    m[k] += nodes[u as usize][k];
+                }
+            }
+            let inv = 1.0 / list.len() as f64;
+            let mut d = [
+                f * (m[0] * inv - x[0]),
+                f * (m[1] * inv - x[1]),
+                f * (m[2] * inv - x[2]),
+            ];
+            let bits = plane_bits[*v as usize];
+            for (b, nrm) in normals.iter().enumerate() {
+                if bits & (1 << b) != 0 {
+                    let dn = d[0] * nrm[0] + d[1] * nrm[1] + d[2] * nrm[2];
+                    for k in 0..3 {
+                        d[k] -= dn * nrm[k];
+                    }
+                }
+            }
+            [x[0] + d[0], x[1] + d[1], x[2] + d[2]]
+        })
+        .collect()
+}
+
+/// The element-quality guard of a half step: the elements that touch a movable node, their
+/// smallest admissible characteristic lengths and the scaled-Jacobian threshold.
+struct Guard<'a> {
+    elements: &'a [[u32; 8]],
+    candidates: &'a [u32],
+    lmin: Vec<f64>,
+    thr: f64,
+    /// Index of a node among the movable ones (`u32::MAX` if not movable).
+    slot: &'a [u32],
+}
+
+impl Guard<'_> {
+    /// Halve the moves of the nodes of poor elements (from `old` towards `target`) until none
+    /// is poor; after three halvings a node's move is undone.
+    fn back_off(
+        &self,
+        nodes: &mut [[f64; 3]],
+        adm: &[(u32, Vec<u32>)],
+        old: &[[f64; 3]],
+        target: &[[f64; 3]],
+        report: &mut SmoothReport,
+    ) {
+        let elements = self.elements;
+        let mut scale = vec![1.0f64; adm.len()];
+        for round in 0.. {
+            let snap: &[[f64; 3]] = nodes;
+            let bad: Vec<u32> = self
+                .candidates
+                .par_iter()
+                .zip(self.lmin.par_iter())
+                .filter(|&(&e, &lm)| {
+                    let x = element_coords(snap, &elements[e as usize]);
+                    min_scaled_jacobian(&x) < self.thr || characteristic_length(&x) < lm
+                })
+                .map(|(&e, _)| e)
+                .collect();
+            if bad.is_empty() {
+                break;
+            }
+            let mut hit = vec![false; adm.len()];
+            for &e in &bad {
+                for &v in &elements[e as usize] {
+                    let q = self.slot[v as usize];
+                    if q != u32::MAX {
+                        hit[q as usize] = true;
+                    }
+                }
+            }
+            for (q, (v, _)) in adm.iter().enumerate() {
+                if !hit[q] || scale[q] == 0.0 {
+                    continue;
+                }
+                if round >= 3 {
+                    scale[q] = 0.0;
+                    report.reverted += 1;
+                } else {
+                    scale[q] *= 0.5;
+                    report.backoffs += 1;
+                }
+                let s = scale[q];
+                let (o, t) = (old[q], target[q]);
+                nodes[*v as usize] = [
+                    o[0] + s * (t[0] - o[0]),
+                    o[1] + s * (t[1] - o[1]),
+                    o[2] + s * (t[2] - o[2]),
+                ];
+            }
+        }
+    }
 }
