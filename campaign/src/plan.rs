@@ -7,12 +7,10 @@
 use crate::phantom_record::PhantomRecord;
 use crate::spec::CampaignSpec;
 use phantom::{location_at, Location, Phantom, PhantomParams};
-use scene::build::build_scene_with;
 use scene::palpation::{PalpationSetup, Place};
-use scene::{Scene, SceneSpec};
+use scene::Scene;
 use serde::{Deserialize, Serialize};
 use solver::element::precision::Precision;
-use solver::output::atomic::write_atomic;
 use std::collections::BTreeMap;
 use std::path::Path;
 pub use surrogate::Split;
@@ -80,13 +78,10 @@ impl Campaign {
         (r.duration / self.base.sample_interval * (1.0 + 1e-9)).floor() as usize + 1
     }
 
-    /// The phantom parameters every run's scene asks for (read back from the scene text, so
-    /// that a phantom built from them is reused by [`build_scene_with`]).
+    /// The phantom parameters every run's scene asks for (so that a phantom built from them is
+    /// reused by every run).
     pub fn phantom_params(&self) -> Result<PhantomParams, String> {
-        let src = self.base.scene_toml();
-        let spec: SceneSpec =
-            toml::from_str(&src).map_err(|e| format!("internal: campaign scene: {e}"))?;
-        spec.mesh.phantom.unwrap_or_default().to_params()
+        self.base.phantom_params()
     }
 
     /// Resolve each location on the built phantom (its skin point); an error names a location
@@ -117,12 +112,7 @@ impl Campaign {
     ) -> Result<Scene, String> {
         std::fs::create_dir_all(dir)
             .map_err(|e| format!("{}: cannot create the run directory: {e}", dir.display()))?;
-        let path = dir.join("scene.toml");
-        let src = self.setup(r).scene_toml();
-        write_atomic(&path, src.as_bytes())?;
-        let spec: SceneSpec = toml::from_str(&src)
-            .map_err(|e| format!("{}: {}", path.display(), e.to_string().trim_end()))?;
-        build_scene_with(spec, &path, &src, Some(phantom.clone()))
+        self.setup(r).build_scene(dir, Some(phantom.clone()))
     }
 
     /// The plan of this campaign on the built phantom `ph` with its resolved locations `locs`:

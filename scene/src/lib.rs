@@ -17,6 +17,7 @@ mod loop_settings;
 mod node_sets;
 pub mod output_plan;
 pub mod palpation;
+mod palpation_scene;
 mod parts;
 pub mod phantom_spec;
 pub mod pilot;

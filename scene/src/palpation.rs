@@ -4,8 +4,9 @@
 //! the inward skin normal in 25 ms with a smooth ramp, penalty contact on the anterior skin,
 //! the back fixed and rollers on the cut planes, and the ROI's stresses sampled every 5 ms.
 //!
-//! [`PalpationSetup::scene_toml`] writes this as an ordinary scene file, so that a palpation is
-//! a scene like any other: `palpa palpate` saves it as `scene.toml` in its output directory,
+//! [`PalpationSetup::scene_spec`] builds it as a typed scene in memory, and
+//! [`PalpationSetup::scene_toml`] writes the same scene as an ordinary scene file, so that a
+//! palpation is a scene like any other: `palpa palpate` saves it as `scene.toml` in its output directory,
 //! and `palpa run` on that file repeats the run exactly. Campaigns and the accuracy study
 //! vary its fields. [`read_probe`] reads the ROI samples back.
 //!
@@ -14,6 +15,7 @@
 //! a tumour the liver law with its shear and Prony moduli scaled by the tumour's stiffness
 //! factor (so its Poisson ratio and relaxation times stay the liver's).
 
+use crate::palpation_scene::{scaled_liver_card, FRAME_FIELDS, HAND_LENGTH, PART_MATERIALS};
 use phantom::DEFAULT_VOXEL;
 use solver::element::{HourglassForm, HourglassModulus};
 use solver::model::StepTarget;
@@ -74,26 +76,20 @@ impl ElementChoice {
             ElementChoice::FullFbar => None,
         }
     }
-    /// Scene keys of the choice.
+    /// Scene keys of the choice, one per line.
     fn scene_keys(&self) -> String {
-        match self.hourglass() {
-            None => "formulation = \"full_fbar\"".into(),
-            Some((HourglassForm::Physical, _)) => {
-                "formulation = \"one_point\", hourglass = \"physical\", hourglass_coefficient = 1.0"
-                    .into()
-            }
-            Some((form, modulus)) => format!(
-                "formulation = \"one_point\", hourglass = \"{}\", hourglass_modulus = \"{}\"",
-                match form {
-                    HourglassForm::Viscous => "viscous",
-                    _ => "stiffness",
-                },
-                match modulus {
-                    HourglassModulus::PWave => "p_wave",
-                    HourglassModulus::Shear => "shear",
-                }
-            ),
+        let (formulation, hourglass, coefficient, modulus) = self.part_keys();
+        let mut s = format!("formulation = {formulation:?}");
+        if let Some(h) = hourglass {
+            s += &format!("\nhourglass = {h:?}");
         }
+        if let Some(c) = coefficient {
+            s += &format!("\nhourglass_coefficient = {c:?}");
+        }
+        if let Some(m) = modulus {
+            s += &format!("\nhourglass_modulus = {m:?}");
+        }
+        s
     }
     /// Short name for tables.
     pub fn label(&self) -> &'static str {
@@ -271,19 +267,6 @@ impl Default for PalpationSetup {
     }
 }
 
-/// The liver card in SI with its moduli scaled by `s` (see the module doc).
-fn scaled_liver_card(s: f64) -> String {
-    let mu = [89.14, 9.965, -92.75].map(|m| m * s);
-    let g = [6970.1, 58327.0, 35291.0].map(|m| m * s);
-    format!(
-        "law = \"ogden\"\ndensity = \"1050 kg/m^3\"\nmu = [\"{} Pa\", \"{} Pa\", \"{} Pa\"]\n\
-         alpha = [1.0, 19.0656, -10.9604]\npoisson_ratio = 0.49\nprony = [\n  \
-         {{ modulus = \"{} Pa\", tau = \"10 ms\" }},\n  {{ modulus = \"{} Pa\", tau = \"100 ms\" }},\n  \
-         {{ modulus = \"{} Pa\", tau = \"1000 ms\" }},\n]\nprony_on = \"green_lagrange\"\n",
-        mu[0], mu[1], mu[2], g[0], g[1], g[2]
-    )
-}
-
 impl PalpationSetup {
     /// Check the values a user can set.
     pub fn validate(&self) -> Result<(), String> {
@@ -329,27 +312,11 @@ impl PalpationSetup {
     /// The phantom parameters its scene asks for (to build the phantom once and share it, see
     /// [`crate::build::build_scene_with`]).
     pub fn phantom_params(&self) -> Result<phantom::PhantomParams, String> {
-        use material::quantity::{Length, Number};
-        crate::phantom_spec::PhantomScene {
-            variant: Some(self.variant.clone()),
-            voxel: Some(Length(self.voxel)),
-            fat_thickness: Some(Length(self.fat_thickness)),
-            respiratory_phase: Some(Number(self.respiratory_phase)),
-            tumours: self
-                .tumours
-                .iter()
-                .map(|t| crate::phantom_spec::TumourScene {
-                    center: t.center.map(Length),
-                    radius: Length(t.radius),
-                    stiffness: Number(t.stiffness),
-                })
-                .collect(),
-            ..Default::default()
-        }
-        .to_params()
+        self.phantom_scene().to_params()
     }
 
-    /// The scene file text. Every quantity is written in SI with its unit.
+    /// The scene file text: [`PalpationSetup::scene_spec`] as a file (a test holds the two
+    /// equal). Every quantity is written in SI with its unit.
     pub fn scene_toml(&self) -> String {
         let mut s = String::new();
         let _ = writeln!(
@@ -365,6 +332,41 @@ impl PalpationSetup {
             self.dt_factor,
             self.precision.label()
         );
+        self.write_mesh(&mut s);
+        self.write_parts(&mut s);
+        s.push_str("[[boundary]]\nnodes = \"back\"\nfix = [\"all\"]\n\n");
+        for (set, ax) in self.rollers() {
+            let _ = writeln!(s, "[[boundary]]\nnodes = {set:?}\nfix = [{ax:?}]\n");
+        }
+        if let Some(t) = self.mass_scaling {
+            let _ = writeln!(
+                s,
+                "[mass_scaling]\ntarget_dt = \"{t}\"\nmax_added = {}\n",
+                self.mass_scaling_limit
+            );
+        }
+        let place = match &self.place {
+            Place::Named(n) => format!("location = {n:?}"),
+            Place::At(x, y) => format!("at = [\"{x} m\", \"{y} m\"]"),
+        };
+        let _ = writeln!(
+            s,
+            "[[hand]]\nname = \"hand\"\n{place}\ndiameter = \"{} m\"\nspacing = \"{} m\"\n\
+             length = \"{HAND_LENGTH} m\"\nmotion = {{ kind = \"displacement\", curve = {{ kind = \"smooth_step\", \
+             value = \"{} m\", end = \"{} s\" }} }}\n",
+            self.finger_diameter, self.finger_spacing, self.depth, self.duration
+        );
+        s.push_str("[contact]\nsurface = \"skin\"\n\n");
+        let _ = writeln!(
+            s,
+            "[output]\ninterval = \"{} s\"\nvtk = {}\nfields = {:?}\nprobe = \"roi\"",
+            self.sample_interval, self.vtk, FRAME_FIELDS
+        );
+        s
+    }
+
+    /// `[mesh]` and `[mesh.phantom]` of the scene file.
+    fn write_mesh(&self, s: &mut String) {
         let _ = writeln!(
             s,
             "[mesh]\ngenerator = \"phantom\"\n\n[mesh.phantom]\nvariant = {:?}\nvoxel = \"{} m\"\n\
@@ -383,73 +385,29 @@ impl PalpationSetup {
             s.push_str("]\n");
         }
         s.push('\n');
+    }
+
+    /// The tumours' `[materials]` and every `[[part]]` of the scene file.
+    fn write_parts(&self, s: &mut String) {
         let el = |part: &str| {
-            let tumour = phantom::is_tumour_part(part);
-            let keys = self
-                .part_elements
-                .get(part)
-                .or_else(|| tumour.then(|| self.part_elements.get("liver")).flatten())
-                .unwrap_or(&self.element)
-                .scene_keys()
-                .replace(", ", "\n");
+            let keys = self.element_of(part).scene_keys();
             match self.max_bulk_ratio {
                 Some(r) => format!("{keys}\nmax_bulk_ratio = {r:?}"),
                 None => keys,
             }
         };
-        let parts = [
-            ("flesh", "paper:flesh"),
-            ("liver", "paper:liver"),
-            ("ribs", "paper:ribs"),
-            ("viscera", "paper:flesh"),
-            ("spine", "paper:ribs"),
-        ];
         let tumour_names: Vec<String> = (0..self.tumours.len())
             .map(phantom::tumour_part_name)
             .collect();
         for (n, t) in tumour_names.iter().zip(&self.tumours) {
             let _ = writeln!(s, "[materials.{n}]\n{}", scaled_liver_card(t.stiffness));
         }
-        for (p, m) in &parts {
+        for (p, m) in &PART_MATERIALS {
             let _ = writeln!(s, "[[part]]\nname = {p:?}\nmaterial = {m:?}\n{}\n", el(p));
         }
         for n in &tumour_names {
             let _ = writeln!(s, "[[part]]\nname = {n:?}\nmaterial = {n:?}\n{}\n", el(n));
         }
-        s.push_str("[[boundary]]\nnodes = \"back\"\nfix = [\"all\"]\n\n");
-        let rollers: &[(&str, &str)] = if self.variant == "full" {
-            &[("cut_ymin", "y"), ("cut_ymax", "y")]
-        } else {
-            &[("cut_xmax", "x"), ("cut_ymin", "y"), ("cut_ymax", "y")]
-        };
-        for (set, ax) in rollers {
-            let _ = writeln!(s, "[[boundary]]\nnodes = {set:?}\nfix = [{ax:?}]\n");
-        }
-        if let Some(t) = self.mass_scaling {
-            let _ = writeln!(
-                s,
-                "[mass_scaling]\ntarget_dt = \"{t}\"\nmax_added = {}\n",
-                self.mass_scaling_limit
-            );
-        }
-        let place = match &self.place {
-            Place::Named(n) => format!("location = {n:?}"),
-            Place::At(x, y) => format!("at = [\"{x} m\", \"{y} m\"]"),
-        };
-        let _ = writeln!(
-            s,
-            "[[hand]]\nname = \"hand\"\n{place}\ndiameter = \"{} m\"\nspacing = \"{} m\"\n\
-             length = \"0.06 m\"\nmotion = {{ kind = \"displacement\", curve = {{ kind = \"smooth_step\", \
-             value = \"{} m\", end = \"{} s\" }} }}\n",
-            self.finger_diameter, self.finger_spacing, self.depth, self.duration
-        );
-        s.push_str("[contact]\nsurface = \"skin\"\n\n");
-        let _ = writeln!(
-            s,
-            "[output]\ninterval = \"{} s\"\nvtk = {}\nfields = [\"displacement\", \"part\", \"von_mises\", \"max_principal\"]\nprobe = \"roi\"",
-            self.sample_interval, self.vtk
-        );
-        s
     }
 }
 

@@ -12,7 +12,6 @@
 
 use super::run::{print_summary, run_loaded};
 use super::units;
-use scene::load_scene;
 use scene::palpation::{read_probe, ElementChoice, Fidelity, PalpationSetup, Place, ProbeSamples};
 use solver::output::atomic::write_atomic;
 use solver::output::history::{column, read_history};
@@ -172,10 +171,8 @@ pub fn palpate(args: &PalpateArgs) -> Result<(), String> {
     let out = &args.out;
     std::fs::create_dir_all(out)
         .map_err(|e| format!("{}: cannot create the output directory: {e}", out.display()))?;
-    let scene_path = out.join("scene.toml");
-    write_atomic(&scene_path, setup.scene_toml().as_bytes())?;
     let t0 = Instant::now();
-    let mut scene = load_scene(&scene_path)?;
+    let mut scene = setup.build_scene(out, None)?;
     let build_s = t0.elapsed().as_secs_f64();
     let ph = scene
         .phantom

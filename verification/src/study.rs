@@ -29,7 +29,6 @@
 //! in a few minutes on two cores; the full study runs the paper's 15 mm in 25 ms.
 
 use phantom::Phantom;
-use scene::build::load_scene_with;
 use scene::palpation::{read_probe, ElementChoice, PalpationSetup, ProbeSamples};
 use scene::run::{run_scene, RunSummary};
 use solver::model::StepTarget;
@@ -171,9 +170,7 @@ fn run_one(
         let p = phantom::build(&setup.phantom_params()?)?;
         phantoms.insert(key, p);
     }
-    let scene_path = dir.join("scene.toml");
-    solver::output::atomic::write_atomic(&scene_path, setup.scene_toml().as_bytes())?;
-    let mut scene = load_scene_with(&scene_path, phantoms.get(&key).cloned())?;
+    let mut scene = setup.build_scene(dir, phantoms.get(&key).cloned())?;
     let centroids = scene
         .phantom
         .as_ref()
