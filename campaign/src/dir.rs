@@ -2,24 +2,12 @@
 //! shard and the [`CampaignPlan`]. A resumed campaign, the shards of a merge and a merge's target
 //! must agree on the plan; [`first_difference`] names where two plans part.
 
+use crate::json_file::{read_json, write_json};
 use crate::plan::CampaignPlan;
 use crate::shard::shard_in;
 use crate::{CAMPAIGN_FILE, CAMPAIGN_FORMAT};
 use serde_json::{json, Value};
-use solver::output::atomic::write_atomic;
 use std::path::Path;
-
-/// Read a JSON file; an error names it.
-pub fn read_json(path: &Path) -> Result<Value, String> {
-    let s = std::fs::read_to_string(path).map_err(|e| format!("{}: {e}", path.display()))?;
-    serde_json::from_str(&s).map_err(|e| format!("{}: {e}", path.display()))
-}
-
-/// Write `v` as pretty JSON, atomically.
-pub fn write_json(path: &Path, v: &Value) -> Result<(), String> {
-    let s = serde_json::to_string_pretty(v).map_err(|e| e.to_string())?;
-    write_atomic(path, s.as_bytes())
-}
 
 /// The campaign description file of a directory: format, solver version, shard and plan.
 pub fn campaign_file(plan: &Value, shard: Option<(usize, usize)>) -> Value {

@@ -67,6 +67,7 @@
 mod assemble;
 mod dir;
 mod execute;
+mod json_file;
 mod merge;
 mod phantom_record;
 mod plan;
@@ -75,11 +76,9 @@ mod shard;
 mod spec;
 
 pub use assemble::{assemble, write_dataset};
-pub use dir::{
-    campaign_file, first_difference, prepare_dir, read_campaign_dir, read_json, write_json,
-    CampaignDir,
-};
+pub use dir::{campaign_file, first_difference, prepare_dir, read_campaign_dir, CampaignDir};
 pub use execute::{execute, run_one, Report, RunEvent};
+pub use json_file::{read_json, write_json};
 pub use merge::{merge, MergeReport};
 
 pub use phantom_record::{GridRecord, PhantomRecord, TumourRecord};

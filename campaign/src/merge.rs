@@ -4,7 +4,8 @@
 //! one of them, else the error names the missing runs and their shards.
 
 use crate::assemble::{assemble, write_dataset};
-use crate::dir::{campaign_file, first_difference, read_campaign_dir, read_json, write_json};
+use crate::dir::{campaign_file, first_difference, read_campaign_dir};
+use crate::json_file::{read_json, write_json};
 use crate::plan::CampaignPlan;
 use crate::run_files::{read_done, run_dir};
 use crate::{CAMPAIGN_FILE, DONE_FILE};

@@ -5,7 +5,6 @@
 //! plan is written through [`serde_json::Value`]), so that a plan reads back to the same bytes.
 
 use crate::phantom_record::PhantomRecord;
-use crate::spec::CampaignSpec;
 use phantom::{location_at, Location, Phantom, PhantomParams};
 use scene::palpation::{PalpationSetup, Place};
 use scene::Scene;
@@ -55,13 +54,6 @@ pub struct Campaign {
 }
 
 impl Campaign {
-    /// The paper's protocol (the defaults of every key).
-    pub fn paper() -> Campaign {
-        CampaignSpec::default()
-            .resolve()
-            .expect("the default campaign is valid")
-    }
-
     /// The palpation of run `r`.
     pub fn setup(&self, r: &PlannedRun) -> PalpationSetup {
         PalpationSetup {

@@ -1,7 +1,7 @@
 //! Shards: run `k` (0-based, in the campaign's order) belongs to shard `k mod n`. A shard's
 //! count is fixed when its directory is made (`campaign.json` records it).
 
-use crate::dir::read_json;
+use crate::json_file::read_json;
 use crate::CAMPAIGN_FILE;
 use serde_json::Value;
 use std::path::Path;

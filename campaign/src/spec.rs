@@ -601,3 +601,12 @@ fn plan_runs(
     }
     Ok(runs)
 }
+
+impl Campaign {
+    /// The paper's protocol (the defaults of every key).
+    pub fn paper() -> Campaign {
+        CampaignSpec::default()
+            .resolve()
+            .expect("the default campaign is valid")
+    }
+}

@@ -1,8 +1,8 @@
-//! A palpation's scene built in memory ([`PalpationSetup::scene_spec`]): the typed
+//! A palpation's scene: built in memory ([`PalpationSetup::scene_spec`]), the typed
 //! [`SceneSpec`] that `palpa palpate`, campaigns and the accuracy study run, with no TOML text in
-//! between. The same scene as a file ([`PalpationSetup::scene_toml`], saved as `scene.toml` so
-//! that `palpa run` repeats the run) parses to exactly this value; a test holds the two equal
-//! for every kind of setting.
+//! between; and as a file ([`PalpationSetup::scene_toml`], saved as `scene.toml` so that
+//! `palpa run` repeats the run), which parses to exactly the same value: a test holds the two
+//! equal for every kind of setting.
 
 use crate::build::build_scene_with;
 use crate::contact_spec::{ContactScene, HandScene, MotionScene};
@@ -20,6 +20,7 @@ use phantom::Phantom;
 use solver::element::{HourglassForm, HourglassModulus};
 use solver::output::atomic::write_atomic;
 use std::collections::BTreeMap;
+use std::fmt::Write;
 use std::path::Path;
 
 /// The phantom parts and their laws (see the palpation module doc); tumours come after them.
@@ -83,6 +84,22 @@ pub(crate) fn scaled_liver_card(s: f64) -> String {
 }
 
 impl ElementChoice {
+    /// Scene keys of the choice, one per line.
+    fn scene_keys(&self) -> String {
+        let (formulation, hourglass, coefficient, modulus) = self.part_keys();
+        let mut s = format!("formulation = {formulation:?}");
+        if let Some(h) = hourglass {
+            s += &format!("\nhourglass = {h:?}");
+        }
+        if let Some(c) = coefficient {
+            s += &format!("\nhourglass_coefficient = {c:?}");
+        }
+        if let Some(m) = modulus {
+            s += &format!("\nhourglass_modulus = {m:?}");
+        }
+        s
+    }
+
     /// The `[[part]]` keys of the choice: formulation, hourglass form, coefficient and modulus.
     pub(crate) fn part_keys(
         &self,
@@ -212,6 +229,101 @@ impl PalpationSetup {
                 surface: Some("skin".into()),
                 ..Default::default()
             }),
+        }
+    }
+
+    /// The scene file text: [`PalpationSetup::scene_spec`] as a file (a test holds the two
+    /// equal). Every quantity is written in SI with its unit.
+    pub fn scene_toml(&self) -> String {
+        let mut s = String::new();
+        let _ = writeln!(
+            s,
+            "# A two-finger palpation of the built-in abdomen phantom, written by palpa.\n\
+             # Run it again with `palpa run scene.toml --out DIR`.\n"
+        );
+        let _ = writeln!(
+            s,
+            "[run]\ntitle = {:?}\nend_time = \"{} s\"\ndt_factor = {}\nprecision = {:?}\n",
+            self.title,
+            self.duration,
+            self.dt_factor,
+            self.precision.label()
+        );
+        self.write_mesh(&mut s);
+        self.write_parts(&mut s);
+        s.push_str("[[boundary]]\nnodes = \"back\"\nfix = [\"all\"]\n\n");
+        for (set, ax) in self.rollers() {
+            let _ = writeln!(s, "[[boundary]]\nnodes = {set:?}\nfix = [{ax:?}]\n");
+        }
+        if let Some(t) = self.mass_scaling {
+            let _ = writeln!(
+                s,
+                "[mass_scaling]\ntarget_dt = \"{t}\"\nmax_added = {}\n",
+                self.mass_scaling_limit
+            );
+        }
+        let place = match &self.place {
+            Place::Named(n) => format!("location = {n:?}"),
+            Place::At(x, y) => format!("at = [\"{x} m\", \"{y} m\"]"),
+        };
+        let _ = writeln!(
+            s,
+            "[[hand]]\nname = \"hand\"\n{place}\ndiameter = \"{} m\"\nspacing = \"{} m\"\n\
+             length = \"{HAND_LENGTH} m\"\nmotion = {{ kind = \"displacement\", curve = {{ kind = \"smooth_step\", \
+             value = \"{} m\", end = \"{} s\" }} }}\n",
+            self.finger_diameter, self.finger_spacing, self.depth, self.duration
+        );
+        s.push_str("[contact]\nsurface = \"skin\"\n\n");
+        let _ = writeln!(
+            s,
+            "[output]\ninterval = \"{} s\"\nvtk = {}\nfields = {:?}\nprobe = \"roi\"",
+            self.sample_interval, self.vtk, FRAME_FIELDS
+        );
+        s
+    }
+
+    /// `[mesh]` and `[mesh.phantom]` of the scene file.
+    fn write_mesh(&self, s: &mut String) {
+        let _ = writeln!(
+            s,
+            "[mesh]\ngenerator = \"phantom\"\n\n[mesh.phantom]\nvariant = {:?}\nvoxel = \"{} m\"\n\
+             fat_thickness = \"{} m\"\nrespiratory_phase = {}",
+            self.variant, self.voxel, self.fat_thickness, self.respiratory_phase
+        );
+        if !self.tumours.is_empty() {
+            s.push_str("tumours = [\n");
+            for t in &self.tumours {
+                let _ = writeln!(
+                    s,
+                    "  {{ center = [\"{} m\", \"{} m\", \"{} m\"], radius = \"{} m\", stiffness = {} }},",
+                    t.center[0], t.center[1], t.center[2], t.radius, t.stiffness
+                );
+            }
+            s.push_str("]\n");
+        }
+        s.push('\n');
+    }
+
+    /// The tumours' `[materials]` and every `[[part]]` of the scene file.
+    fn write_parts(&self, s: &mut String) {
+        let el = |part: &str| {
+            let keys = self.element_of(part).scene_keys();
+            match self.max_bulk_ratio {
+                Some(r) => format!("{keys}\nmax_bulk_ratio = {r:?}"),
+                None => keys,
+            }
+        };
+        let tumour_names: Vec<String> = (0..self.tumours.len())
+            .map(phantom::tumour_part_name)
+            .collect();
+        for (n, t) in tumour_names.iter().zip(&self.tumours) {
+            let _ = writeln!(s, "[materials.{n}]\n{}", scaled_liver_card(t.stiffness));
+        }
+        for (p, m) in &PART_MATERIALS {
+            let _ = writeln!(s, "[[part]]\nname = {p:?}\nmaterial = {m:?}\n{}\n", el(p));
+        }
+        for n in &tumour_names {
+            let _ = writeln!(s, "[[part]]\nname = {n:?}\nmaterial = {n:?}\n{}\n", el(n));
         }
     }
 
