@@ -28,51 +28,59 @@ use crate::trimesh::TriMesh;
 use crate::vec3::*;
 use crate::ContactError;
 
-/// Geometry of one rigid part, as plain data in SI units (m), world coordinates at `t = 0`.
+/// Geometry of one rigid part, as plain data, world coordinates at `t = 0`. Lengths are of
+/// type `L`: `f64` in m (the default, what [`Shape::from_spec`] takes), or a type that carries a
+/// unit, such as a scene file's lengths (`"7.5 mm"`); [`ShapeSpec::map`] turns one into the
+/// other, so the file form and the SI form are one type.
 ///
 /// Deserialises from a table with a `shape` tag, e.g.
 /// `{ shape = "capsule", center = [0, 0, 0.0575], axis = [0, 0, 1], radius = 0.0075, length = 0.05 }`.
 #[derive(Clone, Debug, Deserialize, PartialEq)]
-#[serde(tag = "shape", rename_all = "snake_case", deny_unknown_fields)]
-pub enum ShapeSpec {
+#[serde(
+    tag = "shape",
+    rename_all = "snake_case",
+    deny_unknown_fields,
+    bound(deserialize = "L: Deserialize<'de> + From<f64>")
+)]
+pub enum ShapeSpec<L = f64> {
     /// Sphere of `radius` (m) about `center` (m).
     Sphere {
         /// Centre (m).
-        center: [f64; 3],
+        center: [L; 3],
         /// Radius (m).
-        radius: f64,
+        radius: L,
     },
     /// Capsule (a finger): the segment from `center` to `center + length * axis` swept by a ball of
     /// `radius`. `center` is the centre of the hemispherical fingertip; `axis` points from the tip
     /// towards the hand (normalised internally).
     Capsule {
         /// Centre of the hemispherical tip (m).
-        center: [f64; 3],
+        center: [L; 3],
         /// Direction from the tip towards the other end (unit, normalised internally).
         axis: [f64; 3],
         /// Radius (m).
-        radius: f64,
+        radius: L,
         /// Length of the straight part between the two hemisphere centres (m).
-        length: f64,
+        length: L,
     },
     /// Flat-ended circular cylinder (a flat punch): end face centred at `center`, extending
     /// `length` along `axis`.
     Cylinder {
         /// Centre of the pressing end face (m).
-        center: [f64; 3],
+        center: [L; 3],
         /// Axis from the pressing face into the cylinder (unit, normalised internally).
         axis: [f64; 3],
         /// Radius (m).
-        radius: f64,
+        radius: L,
         /// Length (m).
-        length: f64,
+        length: L,
     },
     /// Box with half extents along its axes; `axes` defaults to the world axes.
     Box {
         /// Centre (m).
-        center: [f64; 3],
+        center: [L; 3],
         /// Half extents along the box axes (m).
-        half_extents: [f64; 3],
+        half_extents: [L; 3],
         /// Box axes (orthonormalised internally; default the world axes).
         #[serde(default)]
         axes: Option<[[f64; 3]; 3]>,
@@ -80,7 +88,7 @@ pub enum ShapeSpec {
     /// Rigid half-space: the solid lies on the side opposite to `normal`.
     Plane {
         /// A point of the plane (m).
-        point: [f64; 3],
+        point: [L; 3],
         /// Outward normal (unit, normalised internally).
         normal: [f64; 3],
     },
@@ -90,24 +98,93 @@ pub enum ShapeSpec {
         /// STL file path.
         path: PathBuf,
         /// Length of one file unit in metres (1e-3 for a file in mm). Default 1.
-        #[serde(default = "one")]
-        scale: f64,
+        /// (`unit` in a scene file: `"1 mm"`.)
+        #[serde(default = "one", alias = "unit")]
+        scale: L,
         /// Translation after scaling (m). Default zero.
-        #[serde(default)]
-        translate: [f64; 3],
+        #[serde(default = "zero3")]
+        translate: [L; 3],
     },
     /// Closed triangle mesh given in memory, e.g. the surface of a meshed rigid part of an
     /// LS-DYNA deck: vertices (m) and triangles, counter-clockwise seen from outside.
     Triangles {
         /// Vertices (m).
-        vertices: Vec<[f64; 3]>,
+        vertices: Vec<[L; 3]>,
         /// Vertex indices of each triangle.
         triangles: Vec<[u32; 3]>,
     },
 }
 
-fn one() -> f64 {
-    1.0
+fn one<L: From<f64>>() -> L {
+    L::from(1.0)
+}
+
+fn zero3<L: From<f64>>() -> [L; 3] {
+    [0.0, 0.0, 0.0].map(L::from)
+}
+
+impl<L: Copy> ShapeSpec<L> {
+    /// The same shape with every length mapped by `f` (e.g. from a unit-carrying type to m).
+    pub fn map<M>(&self, f: impl Fn(L) -> M) -> ShapeSpec<M> {
+        let v = |x: &[L; 3]| x.map(&f);
+        match self {
+            ShapeSpec::Sphere { center, radius } => ShapeSpec::Sphere {
+                center: v(center),
+                radius: f(*radius),
+            },
+            ShapeSpec::Capsule {
+                center,
+                axis,
+                radius,
+                length,
+            } => ShapeSpec::Capsule {
+                center: v(center),
+                axis: *axis,
+                radius: f(*radius),
+                length: f(*length),
+            },
+            ShapeSpec::Cylinder {
+                center,
+                axis,
+                radius,
+                length,
+            } => ShapeSpec::Cylinder {
+                center: v(center),
+                axis: *axis,
+                radius: f(*radius),
+                length: f(*length),
+            },
+            ShapeSpec::Box {
+                center,
+                half_extents,
+                axes,
+            } => ShapeSpec::Box {
+                center: v(center),
+                half_extents: v(half_extents),
+                axes: *axes,
+            },
+            ShapeSpec::Plane { point, normal } => ShapeSpec::Plane {
+                point: v(point),
+                normal: *normal,
+            },
+            ShapeSpec::Stl {
+                path,
+                scale,
+                translate,
+            } => ShapeSpec::Stl {
+                path: path.clone(),
+                scale: f(*scale),
+                translate: v(translate),
+            },
+            ShapeSpec::Triangles {
+                vertices,
+                triangles,
+            } => ShapeSpec::Triangles {
+                vertices: vertices.iter().map(v).collect(),
+                triangles: triangles.clone(),
+            },
+        }
+    }
 }
 
 /// A rigid part ready for queries (normalised axes, built acceleration structures).

@@ -259,6 +259,7 @@ macro_rules! typed_quantity {
             }
         }
         impl From<$name> for f64 { fn from(x: $name) -> f64 { x.0 } }
+        impl From<f64> for $name { fn from(x: f64) -> $name { $name(x) } }
     )*};
 }
 

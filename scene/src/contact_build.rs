@@ -6,12 +6,13 @@
 
 use crate::contact_def::{ContactDef, HandDef, IndenterDef, SurfaceSel};
 use crate::contact_spec::{
-    ContactScene, HandScene, IndenterScene, MotionScene, ShapeScene, DEFAULT_SOFT_SCALE,
+    ContactScene, HandScene, IndenterScene, MotionScene, DEFAULT_SOFT_SCALE,
 };
 use contact::{
     ContactParams, ContactStage, ContactSurface, Curve, ForceControl, HandSpec, IndenterSpec,
     MotionSpec, PenaltyKind, ShapeSpec,
 };
+use material::quantity::Length;
 use solver::contact_stage::ContactForceStage;
 use solver::mesh::Mesh;
 use solver::model::Model;
@@ -19,61 +20,13 @@ use solver::simulation::Simulation;
 use std::collections::HashSet;
 use std::path::Path;
 
-fn v3(l: &[material::quantity::Length; 3]) -> [f64; 3] {
-    [l[0].0, l[1].0, l[2].0]
-}
-
-fn shape(s: &ShapeScene, base: &Path) -> ShapeSpec {
-    match s {
-        ShapeScene::Sphere { center, radius } => ShapeSpec::Sphere {
-            center: v3(center),
-            radius: radius.0,
-        },
-        ShapeScene::Capsule {
-            center,
-            axis,
-            radius,
-            length,
-        } => ShapeSpec::Capsule {
-            center: v3(center),
-            axis: *axis,
-            radius: radius.0,
-            length: length.0,
-        },
-        ShapeScene::Cylinder {
-            center,
-            axis,
-            radius,
-            length,
-        } => ShapeSpec::Cylinder {
-            center: v3(center),
-            axis: *axis,
-            radius: radius.0,
-            length: length.0,
-        },
-        ShapeScene::Box {
-            center,
-            half_extents,
-            axes,
-        } => ShapeSpec::Box {
-            center: v3(center),
-            half_extents: v3(half_extents),
-            axes: *axes,
-        },
-        ShapeScene::Plane { point, normal } => ShapeSpec::Plane {
-            point: v3(point),
-            normal: *normal,
-        },
-        ShapeScene::Stl {
-            path,
-            unit,
-            translate,
-        } => ShapeSpec::Stl {
-            path: base.join(path),
-            scale: unit.map_or(1.0, |u| u.0),
-            translate: translate.as_ref().map_or([0.0; 3], v3),
-        },
+/// A scene's shape in m, an STL path relative to the scene file's folder `base`.
+fn shape(s: &ShapeSpec<Length>, base: &Path) -> ShapeSpec {
+    let mut s = s.map(f64::from);
+    if let ShapeSpec::Stl { path, .. } = &mut s {
+        *path = base.join(&*path);
     }
+    s
 }
 
 fn motion(m: &MotionScene) -> Result<MotionSpec, String> {
@@ -180,7 +133,7 @@ fn hand_spec(h: &HandScene, gap: f64) -> Result<HandSpec, String> {
     };
     Ok(HandSpec {
         name: h.name.clone(),
-        point: v3(point),
+        point: point.map(f64::from),
         direction,
         spacing_axis: h.spacing_axis,
         diameter: h.diameter.0,
@@ -526,5 +479,61 @@ impl BackOff<'_> {
             }
         }
         Ok(gaps)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A scene's shapes read with units (one `ShapeSpec` type, lengths in the file's units)
+    /// and mapped to m; an STL path resolves against the scene's folder, its `unit` is the
+    /// length of one file unit.
+    #[test]
+    fn scene_shapes_map_to_si_and_stl_paths_resolve_against_the_scene() {
+        let src = r#"
+            name = "probe"
+            direction = [0.0, 0.0, -1.0]
+            motion = { kind = "fixed" }
+            part = [
+                { shape = "sphere", center = ["10 mm", "0 m", "2 cm"], radius = "5 mm" },
+                { shape = "stl", path = "meshes/finger.stl", unit = "1 mm", translate = ["1 mm", "0 m", "0 m"] },
+                { shape = "stl", path = "/abs/finger.stl" },
+            ]
+        "#;
+        let ind: IndenterScene = toml::from_str(src).unwrap();
+        let base = Path::new("/work/scene-dir");
+        let s: Vec<ShapeSpec> = ind.part.iter().map(|p| shape(p, base)).collect();
+        assert_eq!(
+            s[0],
+            ShapeSpec::Sphere {
+                center: [0.01, 0.0, 0.02],
+                radius: 0.005
+            }
+        );
+        assert_eq!(
+            s[1],
+            ShapeSpec::Stl {
+                path: base.join("meshes/finger.stl"),
+                scale: 1e-3,
+                translate: [1e-3, 0.0, 0.0]
+            }
+        );
+        assert_eq!(
+            s[2],
+            ShapeSpec::Stl {
+                path: "/abs/finger.stl".into(),
+                scale: 1.0,
+                translate: [0.0; 3]
+            }
+        );
+        // a length without a unit where one is required, and an unknown key, are errors
+        let bad = src.replace("\"5 mm\"", "\"5 s\"");
+        assert!(toml::from_str::<IndenterScene>(&bad).is_err());
+        let bad = src.replace("radius = \"5 mm\"", "radius = \"5 mm\", colour = 1");
+        let e = toml::from_str::<IndenterScene>(&bad)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("colour"), "{e}");
     }
 }

@@ -65,6 +65,7 @@
 //! `soft_scale` and `stiffness_cap` there (the contact stage then lowers the step, see
 //! [`solver::contact_stage`]).
 
+use contact::ShapeSpec;
 use material::quantity::{Force, Length, Number, Time, Velocity};
 use serde::Deserialize;
 
@@ -81,7 +82,7 @@ pub struct IndenterScene {
     /// Motion along the direction.
     pub motion: MotionScene,
     /// Rigid parts (at least one), world coordinates at t = 0.
-    pub part: Vec<ShapeScene>,
+    pub part: Vec<ShapeSpec<Length>>,
     /// Coulomb friction coefficient (default: `[contact] friction`).
     pub friction: Option<Number>,
 }
@@ -117,66 +118,6 @@ pub struct HandScene {
     pub motion: MotionScene,
     /// Coulomb friction coefficient (default: `[contact] friction`).
     pub friction: Option<Number>,
-}
-
-/// A rigid part.
-#[derive(Debug, Deserialize)]
-#[serde(tag = "shape", rename_all = "snake_case", deny_unknown_fields)]
-pub enum ShapeScene {
-    /// Sphere.
-    Sphere {
-        /// Centre.
-        center: [Length; 3],
-        /// Radius.
-        radius: Length,
-    },
-    /// Capsule (a finger): segment from `center` along `axis` swept by `radius`.
-    Capsule {
-        /// Centre of the tip hemisphere.
-        center: [Length; 3],
-        /// From the tip towards the hand.
-        axis: [f64; 3],
-        /// Radius.
-        radius: Length,
-        /// Length of the straight part.
-        length: Length,
-    },
-    /// Flat-ended cylinder (flat punch).
-    Cylinder {
-        /// Centre of the pressing end face.
-        center: [Length; 3],
-        /// From the pressing face into the cylinder.
-        axis: [f64; 3],
-        /// Radius.
-        radius: Length,
-        /// Length.
-        length: Length,
-    },
-    /// Box.
-    Box {
-        /// Centre.
-        center: [Length; 3],
-        /// Half extents along the box axes.
-        half_extents: [Length; 3],
-        /// Box axes (default the world axes).
-        axes: Option<[[f64; 3]; 3]>,
-    },
-    /// Rigid half-space; the solid is on the side opposite to `normal`.
-    Plane {
-        /// A point of the plane.
-        point: [Length; 3],
-        /// Outward normal.
-        normal: [f64; 3],
-    },
-    /// Closed triangle mesh from an STL file.
-    Stl {
-        /// File, relative to the scene file.
-        path: String,
-        /// Length of one file unit (default `"1 m"`; `"1 mm"` for a file in mm).
-        unit: Option<Length>,
-        /// Translation after scaling (default zero).
-        translate: Option<[Length; 3]>,
-    },
 }
 
 /// How an indenter moves along its direction.
