@@ -8,6 +8,7 @@ use crate::contact_def::{ContactDef, HandDef, IndenterDef, SurfaceSel};
 use crate::contact_spec::{
     ContactScene, HandScene, IndenterScene, MotionScene, DEFAULT_SOFT_SCALE,
 };
+use crate::locate::Locate;
 use contact::{
     ContactParams, ContactStage, ContactSurface, Curve, ForceControl, HandSpec, IndenterSpec,
     MotionSpec, PenaltyKind, ShapeSpec,
@@ -158,15 +159,9 @@ pub fn resolve_contact(
     path: &Path,
     src: &str,
 ) -> Result<ContactDef, String> {
-    let line_of = |needle: &str| {
-        src.lines()
-            .position(|l| l.contains(needle))
-            .map(|i| format!("{}:{}", path.display(), i + 1))
-            .unwrap_or_else(|| path.display().to_string())
-    };
-    let at = |needle: &str, key: &str, msg: &dyn std::fmt::Display| {
-        format!("{}: `{key}`: {msg}", line_of(needle))
-    };
+    let loc = Locate { path, src };
+    let line_of = |needle: &str| loc.place(Some(needle));
+    let at = |needle: &str, key: &str, msg: &dyn std::fmt::Display| loc.err(key, Some(needle), msg);
     let base = path.parent().unwrap_or(Path::new("."));
     let mut defs = Vec::new();
     for (i, ind) in indenters.iter().enumerate() {
@@ -214,7 +209,33 @@ pub fn resolve_contact(
         }
     }
 
-    // Surface.
+    let (nodes, parts) = surface_selection(mesh, contact, &at)?;
+    let d = ContactScene::default();
+    let mut params = contact_params(Some(contact.unwrap_or(&d)), 0.0)
+        .map_err(|m| at("[contact]", "contact", &m))?;
+    params.design_dt = contact.and_then(|c| c.design_dt).map(|t| t.0);
+    Ok(ContactDef {
+        indenters: defs,
+        hands: hand_defs,
+        surface: SurfaceSel {
+            nodes,
+            parts,
+            faces: None,
+        },
+        params,
+        origin: format!("{}: `contact`", path.display()),
+        empty_hint: "check `surface` and `parts`".into(),
+    })
+}
+
+/// The contact surface's selection from `[contact]`: a node mask from `surface` (a node set)
+/// and a part mask from `parts`; `at(needle, key, msg)` places an error in the scene file.
+#[allow(clippy::type_complexity)]
+fn surface_selection(
+    mesh: &Mesh,
+    contact: Option<&ContactScene>,
+    at: &dyn Fn(&str, &str, &dyn std::fmt::Display) -> String,
+) -> Result<(Option<Vec<bool>>, Option<Vec<bool>>), String> {
     let c = contact;
     let nodes: Option<Vec<bool>> = match c.and_then(|c| c.surface.as_ref()) {
         None => None,
@@ -251,22 +272,7 @@ pub fn resolve_contact(
             Some(ok)
         }
     };
-    let d = ContactScene::default();
-    let mut params =
-        contact_params(Some(c.unwrap_or(&d)), 0.0).map_err(|m| at("[contact]", "contact", &m))?;
-    params.design_dt = c.and_then(|c| c.design_dt).map(|t| t.0);
-    Ok(ContactDef {
-        indenters: defs,
-        hands: hand_defs,
-        surface: SurfaceSel {
-            nodes,
-            parts,
-            faces: None,
-        },
-        params,
-        origin: format!("{}: `contact`", path.display()),
-        empty_hint: "check `surface` and `parts`".into(),
-    })
+    Ok((nodes, parts))
 }
 
 /// Build the contact stage of a resolved scene: the surface from the mesh boundary (restricted

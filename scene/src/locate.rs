@@ -17,10 +17,15 @@ impl Locate<'_> {
     /// `FILE:LINE: `key`: msg`, with the line of the first occurrence of `needle` in the text,
     /// or `FILE: `key`: msg` where there is no needle or it does not occur.
     pub(crate) fn err(&self, key: &str, needle: Option<&str>, msg: &dyn Display) -> String {
+        format!("{}: `{}`: {}", self.place(needle), key, msg)
+    }
+
+    /// `FILE:LINE` of the first occurrence of `needle` in the text, or `FILE`.
+    pub(crate) fn place(&self, needle: Option<&str>) -> String {
         let line = needle.and_then(|n| self.src.lines().position(|l| l.contains(n)).map(|i| i + 1));
         match line {
-            Some(l) => format!("{}:{}: `{}`: {}", self.path.display(), l, key, msg),
-            None => format!("{}: `{}`: {}", self.path.display(), key, msg),
+            Some(l) => format!("{}:{}", self.path.display(), l),
+            None => self.path.display().to_string(),
         }
     }
 }
