@@ -34,7 +34,10 @@
 //! hemisphere, `axis` tip to hand, `radius`, `length` of the straight part), `cylinder` (flat
 //! punch: `center` of the pressing face, `axis` into the punch, `radius`, `length`), `box`
 //! (`center`, `half_extents`, optional `axes`), `plane` (`point`, outward `normal`), `stl`
-//! (`path` relative to the scene, `unit` = length of one file unit, e.g. `"1 mm"`, `translate`).
+//! (`path` relative to the scene, `unit` = length of one file unit, e.g. `"1 mm"`, `translate`),
+//! `triangles` (`vertices`, `triangles`: a closed surface given inline). They are the contact
+//! crate's [`contact::ShapeSpec`] with lengths that carry units (`ShapeSpec<Length>`), mapped to
+//! m by [`contact::ShapeSpec::map`].
 //!
 //! Motions (`kind = ...`): `fixed`; `displacement` and `velocity` with a `curve` (the same curve
 //! tables as `[[boundary]]`: `constant`, `smooth_step` (from 0), `ramp`, `table`); `force` with
