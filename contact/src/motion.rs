@@ -47,35 +47,44 @@
 use crate::curve::Curve;
 use serde::Deserialize;
 
-/// Force-control parameters (SI). See the module doc for the law.
+/// Force-control parameters. See the module doc for the law. The quantities are of types `F`
+/// (force), `T` (time) and `V` (speed): `f64` in SI by default, what the stage runs; a scene file
+/// reads them with units ([`ForceControl::to_si`] converts). Absent keys take the defaults.
 #[derive(Clone, Debug, Deserialize, PartialEq)]
-#[serde(deny_unknown_fields)]
-pub struct ForceControl {
+#[serde(
+    deny_unknown_fields,
+    bound(deserialize = "F: Deserialize<'de>, T: Deserialize<'de> + From<f64>, \
+                         V: Deserialize<'de> + From<f64>")
+)]
+pub struct ForceControl<F = f64, T = f64, V = f64> {
     /// Target reaction force along the pressing direction (N).
-    pub target: f64,
+    pub target: F,
     /// Time to ramp the force reference from 0 to `target`, counted from first contact (s).
     /// Default 0 (step).
-    #[serde(default)]
-    pub ramp_time: f64,
+    #[serde(default = "default_ramp")]
+    pub ramp_time: T,
     /// Speed before contact, and speed limit at all times (m/s). Default 0.1.
     #[serde(default = "default_approach")]
-    pub approach_speed: f64,
+    pub approach_speed: V,
     /// Closed-loop time constant (s). Default 5 ms.
     #[serde(default = "default_tau")]
-    pub time_constant: f64,
+    pub time_constant: T,
     /// Low-pass time constant of the measured force (s). Default 0.5 ms.
     #[serde(default = "default_filter")]
-    pub filter_time: f64,
+    pub filter_time: T,
 }
 
-fn default_approach() -> f64 {
-    0.1
+fn default_ramp<T: From<f64>>() -> T {
+    T::from(0.0)
 }
-fn default_tau() -> f64 {
-    5e-3
+fn default_approach<V: From<f64>>() -> V {
+    V::from(0.1)
 }
-fn default_filter() -> f64 {
-    5e-4
+fn default_tau<T: From<f64>>() -> T {
+    T::from(5e-3)
+}
+fn default_filter<T: From<f64>>() -> T {
+    T::from(5e-4)
 }
 
 impl ForceControl {
@@ -83,7 +92,7 @@ impl ForceControl {
     pub fn new(target: f64) -> Self {
         ForceControl {
             target,
-            ramp_time: 0.0,
+            ramp_time: default_ramp(),
             approach_speed: default_approach(),
             time_constant: default_tau(),
             filter_time: default_filter(),
@@ -91,26 +100,43 @@ impl ForceControl {
     }
 }
 
-/// How an indenter moves along its direction.
+impl<F: Copy + Into<f64>, T: Copy + Into<f64>, V: Copy + Into<f64>> ForceControl<F, T, V> {
+    /// The same parameters in SI.
+    pub fn to_si(&self) -> ForceControl {
+        ForceControl {
+            target: self.target.into(),
+            ramp_time: self.ramp_time.into(),
+            approach_speed: self.approach_speed.into(),
+            time_constant: self.time_constant.into(),
+            filter_time: self.filter_time.into(),
+        }
+    }
+}
+
+/// How an indenter moves along its direction. The curves and the force control are of types
+/// `D` (travel), `V` (speed) and `F`: [`Curve`] and [`ForceControl`] in SI by default, what the
+/// stage runs; a scene file gives its curves and force with units and the scene maps them.
+///
+/// Deserialises from a table with a `kind` tag and, for a prescribed motion, its `curve`:
+/// `{ kind = "displacement", curve = { curve = "smooth_step", amplitude = 0.015, duration = 0.025 } }`,
+/// `{ kind = "force", target = 20.0, ramp_time = 0.01 }`.
 #[derive(Clone, Debug, Deserialize, PartialEq)]
-#[serde(tag = "kind", rename_all = "snake_case")]
-pub enum MotionSpec {
+#[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
+pub enum MotionSpec<D = Curve, V = Curve, F = ForceControl> {
     /// Does not move.
     Fixed,
     /// Prescribed travel `s(t)` (m) along the direction.
     Displacement {
         /// Travel (m) versus time.
-        #[serde(flatten)]
-        curve: Curve,
+        curve: D,
     },
     /// Prescribed speed `ds/dt` (m/s) along the direction.
     Velocity {
         /// Speed (m/s) versus time.
-        #[serde(flatten)]
-        curve: Curve,
+        curve: V,
     },
     /// Force control (see [`ForceControl`]).
-    Force(ForceControl),
+    Force(F),
 }
 
 impl MotionSpec {

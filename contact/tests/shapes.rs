@@ -358,7 +358,7 @@ fn curves_and_motion_specs() {
     let toml_src = r#"
         name = "finger1"
         direction = [0, 0, -1]
-        motion = { kind = "displacement", curve = "smooth_step", amplitude = 0.015, duration = 0.025 }
+        motion = { kind = "displacement", curve = { curve = "smooth_step", amplitude = 0.015, duration = 0.025 } }
         [[parts]]
         shape = "capsule"
         center = [0, 0, 0.0575]
@@ -387,7 +387,7 @@ fn curves_and_motion_specs() {
         spacing = 0.02
         length = 0.07
         tilt = 0.2
-        motion = { kind = "velocity", curve = "constant", value = 0.1 }
+        motion = { kind = "velocity", curve = { curve = "constant", value = 0.1 } }
         "#,
     )
     .unwrap();

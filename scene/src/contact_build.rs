@@ -10,8 +10,8 @@ use crate::contact_spec::{
 };
 use crate::locate::Locate;
 use contact::{
-    ContactParams, ContactStage, ContactSurface, Curve, ForceControl, HandSpec, IndenterSpec,
-    MotionSpec, PenaltyKind, ShapeSpec,
+    ContactParams, ContactStage, ContactSurface, Curve, HandSpec, IndenterSpec, MotionSpec,
+    PenaltyKind, ShapeSpec,
 };
 use material::quantity::Length;
 use solver::contact_stage::ContactForceStage;
@@ -30,37 +30,18 @@ fn shape(s: &ShapeSpec<Length>, base: &Path) -> ShapeSpec {
     s
 }
 
+/// A scene's motion in SI: its curves translated
+/// ([`crate::curve_spec::CurveSpec::motion_curve`]), its force control mapped.
 fn motion(m: &MotionScene) -> Result<MotionSpec, String> {
     Ok(match m {
-        MotionScene::Fixed => MotionSpec::Fixed,
-        MotionScene::Displacement { curve } => MotionSpec::Displacement {
+        MotionSpec::Fixed => MotionSpec::Fixed,
+        MotionSpec::Displacement { curve } => MotionSpec::Displacement {
             curve: curve.motion_curve()?,
         },
-        MotionScene::Velocity { curve } => MotionSpec::Velocity {
+        MotionSpec::Velocity { curve } => MotionSpec::Velocity {
             curve: curve.motion_curve()?,
         },
-        MotionScene::Force {
-            target,
-            ramp_time,
-            approach_speed,
-            time_constant,
-            filter_time,
-        } => {
-            let mut fc = ForceControl::new(target.0);
-            if let Some(t) = ramp_time {
-                fc.ramp_time = t.0;
-            }
-            if let Some(v) = approach_speed {
-                fc.approach_speed = v.0;
-            }
-            if let Some(t) = time_constant {
-                fc.time_constant = t.0;
-            }
-            if let Some(t) = filter_time {
-                fc.filter_time = t.0;
-            }
-            MotionSpec::Force(fc)
-        }
+        MotionSpec::Force(fc) => MotionSpec::Force(fc.to_si()),
     })
 }
 

@@ -68,7 +68,7 @@
 //! `soft_scale` and `stiffness_cap` there (the contact stage then lowers the step, see
 //! [`solver::contact_stage`]).
 
-use contact::ShapeSpec;
+use contact::{ForceControl, MotionSpec, ShapeSpec};
 use material::quantity::{Force, Length, Number, Time, Velocity};
 use serde::Deserialize;
 
@@ -123,36 +123,11 @@ pub struct HandScene {
     pub friction: Option<Number>,
 }
 
-/// How an indenter moves along its direction.
-#[derive(Debug, Deserialize)]
-#[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
-pub enum MotionScene {
-    /// Does not move.
-    Fixed,
-    /// Prescribed travel along the direction.
-    Displacement {
-        /// Travel versus time.
-        curve: CurveSpec<Length>,
-    },
-    /// Prescribed speed along the direction.
-    Velocity {
-        /// Speed versus time.
-        curve: CurveSpec<Velocity>,
-    },
-    /// Press until the reaction along the direction reaches `target`, then hold.
-    Force {
-        /// Target reaction.
-        target: Force,
-        /// Ramp of the force reference from first contact (default 0: a step).
-        ramp_time: Option<Time>,
-        /// Speed before contact and speed limit (default 0.1 m/s).
-        approach_speed: Option<Velocity>,
-        /// Closed-loop time constant (default 5 ms).
-        time_constant: Option<Time>,
-        /// Low-pass time constant of the measured force (default 0.5 ms).
-        filter_time: Option<Time>,
-    },
-}
+/// How an indenter moves along its direction, as a scene gives it: the contact crate's
+/// [`MotionSpec`] with a travel curve in lengths, a speed curve in speeds and the force control
+/// with units ([`crate::contact_build`] maps it to SI).
+pub type MotionScene =
+    MotionSpec<CurveSpec<Length>, CurveSpec<Velocity>, ForceControl<Force, Time, Velocity>>;
 
 /// `[contact]`: settings shared by all indenters. All optional.
 #[derive(Debug, Default, Deserialize)]
