@@ -17,8 +17,10 @@
 
 use crate::element::precision::{NarrowRef, Refs};
 use crate::element::{max_face_area, Nodal};
-use crate::element::{physical, surface_mode_factor, Formulation, HourglassForm, HourglassModulus};
-use crate::hex::{element_geometry, hourglass_gamma};
+use crate::element::{
+    physical, surface_mode_factor, Formulation, Hourglass, HourglassForm, HourglassModulus,
+};
+use crate::hex::{element_geometry, hourglass_gamma, ElementGeometry};
 use crate::mesh::Mesh;
 use material::real::{F64x8, Real, LANES};
 use material::Material;
@@ -576,36 +578,30 @@ impl Model {
         mass_scaling: Option<MassScaling>,
         dt_factor: f64,
     ) -> Result<Model, SolverError> {
-        if mesh.element_part.len() != mesh.elements.len() {
-            return Err(SolverError::Invalid("every element needs a part".into()));
-        }
-        for (e, c) in mesh.elements.iter().enumerate() {
-            for &n in c {
-                if n as usize >= mesh.nodes.len() {
-                    return Err(SolverError::Invalid(format!(
-                        "element {e} refers to node {n}, but the mesh has {} nodes",
-                        mesh.nodes.len()
-                    )));
-                }
-            }
-        }
-        let mut mass = vec![0.0; mesh.nodes.len()];
-        let mut groups = Vec::new();
-        let mut part_mass: Vec<PartMass> = parts
-            .iter()
-            .map(|p| PartMass {
-                name: p.name.clone(),
-                ..Default::default()
-            })
-            .collect();
-        let mut initial_dt = (f64::INFINITY, 0u32);
+        check_connectivity(&mesh)?;
         // The target step; a multiple of the initial step needs that step first.
         let fixed_target = match mass_scaling.map(|m| m.target) {
             None => None,
             Some(StepTarget::Step(t)) => Some(t),
             Some(StepTarget::Initial(k)) => Some(k * dt_factor * natural_step(&mesh, &parts)),
         };
-        let mut scaled_dt = f64::INFINITY;
+        let mut builder = Builder {
+            mesh: &mesh,
+            dt_factor,
+            target: fixed_target,
+            scaling: mass_scaling.is_some(),
+            mass: vec![0.0; mesh.nodes.len()],
+            part_mass: parts
+                .iter()
+                .map(|p| PartMass {
+                    name: p.name.clone(),
+                    ..Default::default()
+                })
+                .collect(),
+            initial_dt: (f64::INFINITY, 0u32),
+            scaled_dt: f64::INFINITY,
+        };
+        let mut groups = Vec::new();
         for (pi, part) in parts.iter().enumerate() {
             let elems: Vec<u32> = (0..mesh.elements.len() as u32)
                 .filter(|&e| mesh.element_part[e as usize] as usize == pi)
@@ -613,195 +609,17 @@ impl Model {
             if elems.is_empty() {
                 continue;
             }
-            let n = elems.len();
-            let form = part.formulation;
-            let law = &part.material;
-            let rho = law.density();
-            let (c0, kappa) = step_constants(law);
-            let n_ip = form.n_ip();
-            let stride = law.history_len() * n_ip;
-            let mut g = Group {
-                part: pi,
-                elements: elems.clone(),
-                conn: Vec::with_capacity(n),
-                grad: Vec::new(),
-                vol0: Vec::with_capacity(n),
-                gamma: Vec::new(),
-                hg_scale: Vec::new(),
-                hg_frame: Vec::new(),
-                hg_inv_len: Vec::new(),
-                hg_moduli: [0.0; 3],
-                narrow: None,
-                gp_grad: Vec::new(),
-                gp_weight: Vec::new(),
-                history_stride: stride,
-                history: vec![F64x8::splat(0.0); stride * n.div_ceil(LANES)],
-                density_scale: Vec::new(),
-                colours: Vec::new(),
-                max_node: 0,
-                hourglass: GroupHourglass::default(),
-                chunks: vec![ChunkOut::default(); n.div_ceil(CHUNK)],
-                eroded: Vec::new(),
-                dt_kappa: 1.0,
-                dt_floor: 0.0,
-                lumped: Vec::new(),
-            };
-            let mut scale = Vec::with_capacity(n);
-            let mut grad: Vec<Nodal> = Vec::with_capacity(n);
-            let mut gamma: Vec<[[f64; 8]; 4]> = Vec::new();
-            let mut frames: Vec<([[f64; 3]; 3], [f64; 3])> = Vec::new();
-            let mut gp_grad: Vec<[Nodal; 8]> = Vec::new();
-            let mut gp_weight: Vec<[f64; 8]> = Vec::new();
-            let lambda2mu = rho * c0 * c0;
-            g.dt_kappa = kappa;
-            if let Some(t) = fixed_target {
-                g.dt_floor = t / (dt_factor * g.dt_kappa);
-            }
-            // Hourglass scaling of the part (see `HourglassModulus`): the stiffness form's
-            // modulus, and the factor on c of the viscous form.
-            let (hg_modulus, hg_c_ratio) = match form {
-                Formulation::OnePoint(hg) if hg.modulus == HourglassModulus::Shear => {
-                    let two_mu = 2.0 * law.initial_shear_modulus();
-                    (two_mu, (two_mu / lambda2mu).sqrt())
-                }
-                _ => (lambda2mu, 1.0),
-            };
-            if matches!(form, Formulation::OnePoint(h) if h.form == HourglassForm::Physical) {
-                let mu = law.initial_shear_modulus();
-                let k = lambda2mu - 4.0 * mu / 3.0;
-                if k.is_nan() || mu.is_nan() || k <= 0.0 || mu <= 0.0 {
-                    return Err(SolverError::Invalid(format!(
-                        "part `{}`: physical hourglass control needs a positive shear and bulk modulus (its law has G = {mu:e} Pa, K = {k:e} Pa)",
-                        part.name
-                    )));
-                }
-                let (e, nu) = material::law::young_poisson(k, mu);
-                g.hg_moduli = [e, nu, mu];
-            }
-            for &e in &elems {
-                let conn = mesh.elements[e as usize];
-                let x: [[f64; 3]; 8] = std::array::from_fn(|a| mesh.nodes[conn[a] as usize]);
-                let geo =
-                    element_geometry(&x).map_err(|(corner, det)| SolverError::InvertedElement {
-                        element: e,
-                        part: part.name.clone(),
-                        corner,
-                        det,
-                    })?;
-                g.conn.push(conn);
-                g.vol0.push(geo.volume);
-                match form {
-                    Formulation::OnePoint(hg) => {
-                        grad.push(geo.mean_grad);
-                        gamma.push(hourglass_gamma(&x, &geo.mean_grad));
-                        if hg.form == HourglassForm::Physical {
-                            frames.push(physical::element_frame(&x).ok_or_else(|| {
-                                SolverError::Invalid(format!(
-                                    "element {e} (part `{}`): no element frame for physical hourglass control (an edge of zero length)",
-                                    part.name
-                                ))
-                            })?);
-                            g.hg_scale.push(hg.coefficient * geo.volume / 3.0);
-                        } else if hg.form == HourglassForm::Stiffness {
-                            let mut bb = 0.0;
-                            for i in 0..3 {
-                                for a in 0..8 {
-                                    let b = geo.mean_grad[i][a] * geo.volume;
-                                    bb += b * b;
-                                }
-                            }
-                            g.hg_scale
-                                .push(hg.coefficient * hg_modulus * bb / (3.0 * geo.volume) / 64.0);
-                        } else {
-                            // The kernel multiplies by the current wave speed c.
-                            g.hg_scale.push(
-                                hg.coefficient
-                                    * rho
-                                    * geo.volume.powf(2.0 / 3.0)
-                                    * 0.25
-                                    * hg_c_ratio,
-                            );
-                        }
-                    }
-                    Formulation::Full { .. } => {
-                        grad.push(geo.mean_grad);
-                        gp_grad.push(geo.gp_grad);
-                        gp_weight.push(geo.gp_weight);
-                    }
-                }
-                let dte = g.dt_kappa * initial_element_dt(&x, geo.volume, c0);
-                if dte < initial_dt.0 {
-                    initial_dt = (dte, e);
-                }
-                let mut s = 1.0;
-                if let Some(target) = fixed_target {
-                    let own = dt_factor * dte;
-                    if own < target {
-                        s = (target / own).powi(2);
-                        part_mass[pi].scaled_elements += 1;
-                    }
-                }
-                scaled_dt = scaled_dt.min(dte * s.sqrt());
-                scale.push(s);
-                if mass_scaling.is_some() {
-                    g.lumped.push(geo.lumped_volume);
-                }
-                part_mass[pi].physical += rho * geo.volume;
-                part_mass[pi].added += rho * geo.volume * (s - 1.0);
-                part_mass[pi].elements += 1;
-                for a in 0..8 {
-                    mass[conn[a] as usize] += rho * s * geo.lumped_volume[a];
-                }
-            }
-            if mass_scaling.is_some() {
-                g.density_scale = scale;
-            }
-            let nodal = |e: &[&Nodal; LANES]| -> Nodal<F64x8> {
-                std::array::from_fn(|i| std::array::from_fn(|a| lanes(|l| e[l][i][a])))
-            };
-            g.grad = batched(&grad, nodal);
-            g.gamma = batched(&gamma, |e| {
-                std::array::from_fn(|k| std::array::from_fn(|a| lanes(|l| e[l][k][a])))
-            });
-            g.hg_frame = batched(&frames, |e| {
-                std::array::from_fn(|i| std::array::from_fn(|j| lanes(|l| e[l].0[i][j])))
-            });
-            g.hg_inv_len = batched(&frames, |e| std::array::from_fn(|j| lanes(|l| e[l].1[j])));
-            g.gp_grad = batched(&gp_grad, |e| {
-                std::array::from_fn(|gp| {
-                    std::array::from_fn(|i| std::array::from_fn(|a| lanes(|l| e[l][gp][i][a])))
-                })
-            });
-            g.gp_weight = batched(&gp_weight, |e| {
-                std::array::from_fn(|gp| lanes(|l| e[l][gp]))
-            });
-            if stride > 0 {
-                let hl = law.history_len();
-                let mut h0 = vec![0.0; hl];
-                material::with_law!(law, l => material::Law::init_history(l, &mut h0));
-                for (k, h) in g.history.iter_mut().enumerate() {
-                    *h = F64x8::splat(h0[k % stride % hl]);
-                }
-            }
-            g.colours = colour_chunks(&g.conn, mesh.nodes.len());
-            g.max_node = g.conn.iter().flatten().copied().max().unwrap_or(0) as usize;
-            groups.push(g);
+            groups.push(builder.group(pi, part, elems)?);
         }
+        let Builder {
+            mass,
+            part_mass,
+            initial_dt,
+            scaled_dt,
+            ..
+        } = builder;
         if let Some(ms) = mass_scaling {
-            let phys: f64 = part_mass.iter().map(|p| p.physical).sum();
-            let added: f64 = part_mass.iter().map(|p| p.added).sum();
-            if added > ms.max_added * phys {
-                let worst = part_mass
-                    .iter()
-                    .max_by(|a, b| a.added.total_cmp(&b.added))
-                    .map(|p| p.name.clone())
-                    .unwrap_or_default();
-                return Err(SolverError::MassScalingLimit {
-                    added_fraction: added / phys,
-                    limit: ms.max_added,
-                    part: worst,
-                });
-            }
+            check_added_mass(&ms, &part_mass)?;
         }
         if let Some(n) = mass.iter().position(|&m| !(m > 0.0)) {
             return Err(SolverError::Invalid(format!(
@@ -825,7 +643,6 @@ impl Model {
             },
         })
     }
-
     /// Total physical mass (kg).
     pub fn physical_mass(&self) -> f64 {
         self.part_mass.iter().map(|p| p.physical).sum()
@@ -833,6 +650,345 @@ impl Model {
     /// Total added mass (kg).
     pub fn added_mass(&self) -> f64 {
         self.part_mass.iter().map(|p| p.added).sum()
+    }
+}
+
+/// Every element has a part and refers to nodes of the mesh.
+fn check_connectivity(mesh: &Mesh) -> Result<(), SolverError> {
+    if mesh.element_part.len() != mesh.elements.len() {
+        return Err(SolverError::Invalid("every element needs a part".into()));
+    }
+    for (e, c) in mesh.elements.iter().enumerate() {
+        for &n in c {
+            if n as usize >= mesh.nodes.len() {
+                return Err(SolverError::Invalid(format!(
+                    "element {e} refers to node {n}, but the mesh has {} nodes",
+                    mesh.nodes.len()
+                )));
+            }
+        }
+    }
+    Ok(())
+}
+
+/// The mass-scaling limit at build time: the added mass of the whole model may be at most
+/// `max_added` times its physical mass; the error names the part with the most added mass.
+fn check_added_mass(ms: &MassScaling, part_mass: &[PartMass]) -> Result<(), SolverError> {
+    let phys: f64 = part_mass.iter().map(|p| p.physical).sum();
+    let added: f64 = part_mass.iter().map(|p| p.added).sum();
+    if added > ms.max_added * phys {
+        let worst = part_mass
+            .iter()
+            .max_by(|a, b| a.added.total_cmp(&b.added))
+            .map(|p| p.name.clone())
+            .unwrap_or_default();
+        return Err(SolverError::MassScalingLimit {
+            added_fraction: added / phys,
+            limit: ms.max_added,
+            part: worst,
+        });
+    }
+    Ok(())
+}
+
+/// What [`Model::build`] keeps while it goes through the parts: the settings every part shares,
+/// and the nodal masses, the mass report and the initial steps summed so far.
+struct Builder<'m> {
+    mesh: &'m Mesh,
+    /// Time-step safety factor.
+    dt_factor: f64,
+    /// Mass scaling's target step (s), if any.
+    target: Option<f64>,
+    /// Mass scaling is on: groups keep their density scales and lumped volumes.
+    scaling: bool,
+    /// Nodal mass including mass scaling (kg).
+    mass: Vec<f64>,
+    /// Per-part mass report.
+    part_mass: Vec<PartMass>,
+    /// Smallest initial step without mass scaling (s), and its element.
+    initial_dt: (f64, u32),
+    /// Smallest initial step with mass scaling (s).
+    scaled_dt: f64,
+}
+
+/// The constants of one part that its elements' reference data and steps need.
+struct PartConstants<'p> {
+    part: &'p Part,
+    /// Density (kg/m^3).
+    rho: f64,
+    /// Initial wave speed (m/s).
+    c0: f64,
+    /// The stiffness hourglass form's modulus (Pa), see [`HourglassModulus`].
+    hg_modulus: f64,
+    /// The viscous hourglass form's factor on the wave speed.
+    hg_c_ratio: f64,
+}
+
+/// One group's reference data element by element (arrays of structs), before it is put in
+/// lanes ([`ElementData::batch_into`]), and the density scale of each element.
+struct ElementData {
+    scale: Vec<f64>,
+    grad: Vec<Nodal>,
+    gamma: Vec<[[f64; 8]; 4]>,
+    frames: Vec<([[f64; 3]; 3], [f64; 3])>,
+    gp_grad: Vec<[Nodal; 8]>,
+    gp_weight: Vec<[f64; 8]>,
+}
+
+impl Builder<'_> {
+    /// The group of part `pi`, whose elements are `elems`: reference data, history and chunk
+    /// colouring. Adds the elements' masses and initial steps to the builder's totals.
+    fn group(&mut self, pi: usize, part: &Part, elems: Vec<u32>) -> Result<Group, SolverError> {
+        let n = elems.len();
+        let law = &part.material;
+        let rho = law.density();
+        let (c0, kappa) = step_constants(law);
+        let stride = law.history_len() * part.formulation.n_ip();
+        let mut g = empty_group(pi, elems.clone(), stride);
+        let mut data = ElementData {
+            scale: Vec::with_capacity(n),
+            grad: Vec::with_capacity(n),
+            gamma: Vec::new(),
+            frames: Vec::new(),
+            gp_grad: Vec::new(),
+            gp_weight: Vec::new(),
+        };
+        let lambda2mu = rho * c0 * c0;
+        g.dt_kappa = kappa;
+        if let Some(t) = self.target {
+            g.dt_floor = t / (self.dt_factor * g.dt_kappa);
+        }
+        let (hg_modulus, hg_c_ratio) = hourglass_scaling(part, lambda2mu);
+        if let Some(moduli) = physical_moduli(part, lambda2mu)? {
+            g.hg_moduli = moduli;
+        }
+        let pc = PartConstants {
+            part,
+            rho,
+            c0,
+            hg_modulus,
+            hg_c_ratio,
+        };
+        for &e in &elems {
+            self.element(&mut g, &mut data, &pc, pi, e)?;
+        }
+        if self.scaling {
+            g.density_scale = std::mem::take(&mut data.scale);
+        }
+        data.batch_into(&mut g);
+        if stride > 0 {
+            init_history(&mut g, law, stride);
+        }
+        g.colours = colour_chunks(&g.conn, self.mesh.nodes.len());
+        g.max_node = g.conn.iter().flatten().copied().max().unwrap_or(0) as usize;
+        Ok(g)
+    }
+
+    /// Add element `e` of part `pi` to its group: its geometry and reference data, its initial
+    /// step and the density scale mass scaling gives it, and its lumped mass.
+    fn element(
+        &mut self,
+        g: &mut Group,
+        data: &mut ElementData,
+        pc: &PartConstants,
+        pi: usize,
+        e: u32,
+    ) -> Result<(), SolverError> {
+        let conn = self.mesh.elements[e as usize];
+        let x: [[f64; 3]; 8] = std::array::from_fn(|a| self.mesh.nodes[conn[a] as usize]);
+        let geo = element_geometry(&x).map_err(|(corner, det)| SolverError::InvertedElement {
+            element: e,
+            part: pc.part.name.clone(),
+            corner,
+            det,
+        })?;
+        g.conn.push(conn);
+        g.vol0.push(geo.volume);
+        data.push(g, pc, e, &x, &geo)?;
+        let dte = g.dt_kappa * initial_element_dt(&x, geo.volume, pc.c0);
+        if dte < self.initial_dt.0 {
+            self.initial_dt = (dte, e);
+        }
+        let mut s = 1.0;
+        if let Some(target) = self.target {
+            let own = self.dt_factor * dte;
+            if own < target {
+                s = (target / own).powi(2);
+                self.part_mass[pi].scaled_elements += 1;
+            }
+        }
+        self.scaled_dt = self.scaled_dt.min(dte * s.sqrt());
+        data.scale.push(s);
+        if self.scaling {
+            g.lumped.push(geo.lumped_volume);
+        }
+        let rho = pc.rho;
+        let pm = &mut self.part_mass[pi];
+        pm.physical += rho * geo.volume;
+        pm.added += rho * geo.volume * (s - 1.0);
+        pm.elements += 1;
+        for a in 0..8 {
+            self.mass[conn[a] as usize] += rho * s * geo.lumped_volume[a];
+        }
+        Ok(())
+    }
+}
+
+/// A group of part `part` with its elements and history buffer, the rest of its data still
+/// empty.
+fn empty_group(part: usize, elements: Vec<u32>, stride: usize) -> Group {
+    let n = elements.len();
+    Group {
+        part,
+        elements,
+        conn: Vec::with_capacity(n),
+        grad: Vec::new(),
+        vol0: Vec::with_capacity(n),
+        gamma: Vec::new(),
+        hg_scale: Vec::new(),
+        hg_frame: Vec::new(),
+        hg_inv_len: Vec::new(),
+        hg_moduli: [0.0; 3],
+        narrow: None,
+        gp_grad: Vec::new(),
+        gp_weight: Vec::new(),
+        history_stride: stride,
+        history: vec![F64x8::splat(0.0); stride * n.div_ceil(LANES)],
+        density_scale: Vec::new(),
+        colours: Vec::new(),
+        max_node: 0,
+        hourglass: GroupHourglass::default(),
+        chunks: vec![ChunkOut::default(); n.div_ceil(CHUNK)],
+        eroded: Vec::new(),
+        dt_kappa: 1.0,
+        dt_floor: 0.0,
+        lumped: Vec::new(),
+    }
+}
+
+/// Hourglass scaling of a part (see [`HourglassModulus`]): the stiffness form's modulus, and
+/// the factor on c of the viscous form. `lambda2mu` is the law's `rho c0^2`.
+fn hourglass_scaling(part: &Part, lambda2mu: f64) -> (f64, f64) {
+    match part.formulation {
+        Formulation::OnePoint(hg) if hg.modulus == HourglassModulus::Shear => {
+            let two_mu = 2.0 * part.material.initial_shear_modulus();
+            (two_mu, (two_mu / lambda2mu).sqrt())
+        }
+        _ => (lambda2mu, 1.0),
+    }
+}
+
+/// Young's modulus, Poisson's ratio and shear modulus of a part with the physical hourglass
+/// form (None for other formulations); an error unless its law's shear and bulk moduli are
+/// positive.
+fn physical_moduli(part: &Part, lambda2mu: f64) -> Result<Option<[f64; 3]>, SolverError> {
+    if !matches!(part.formulation, Formulation::OnePoint(h) if h.form == HourglassForm::Physical) {
+        return Ok(None);
+    }
+    let mu = part.material.initial_shear_modulus();
+    let k = lambda2mu - 4.0 * mu / 3.0;
+    if k.is_nan() || mu.is_nan() || k <= 0.0 || mu <= 0.0 {
+        return Err(SolverError::Invalid(format!(
+            "part `{}`: physical hourglass control needs a positive shear and bulk modulus (its law has G = {mu:e} Pa, K = {k:e} Pa)",
+            part.name
+        )));
+    }
+    let (e, nu) = material::law::young_poisson(k, mu);
+    Ok(Some([e, nu, mu]))
+}
+
+/// Fill a group's history buffer with its law's initial history values.
+fn init_history(g: &mut Group, law: &Material, stride: usize) {
+    let hl = law.history_len();
+    let mut h0 = vec![0.0; hl];
+    material::with_law!(law, l => material::Law::init_history(l, &mut h0));
+    for (k, h) in g.history.iter_mut().enumerate() {
+        *h = F64x8::splat(h0[k % stride % hl]);
+    }
+}
+
+impl ElementData {
+    /// The reference data of element `e` (nodes `x`, geometry `geo`) that its formulation
+    /// needs; the one-point element's hourglass scale goes straight to the group.
+    fn push(
+        &mut self,
+        g: &mut Group,
+        pc: &PartConstants,
+        e: u32,
+        x: &[[f64; 3]; 8],
+        geo: &ElementGeometry,
+    ) -> Result<(), SolverError> {
+        match pc.part.formulation {
+            Formulation::OnePoint(hg) => {
+                self.grad.push(geo.mean_grad);
+                self.gamma.push(hourglass_gamma(x, &geo.mean_grad));
+                g.hg_scale.push(self.hourglass_scale(hg, pc, e, x, geo)?);
+            }
+            Formulation::Full { .. } => {
+                self.grad.push(geo.mean_grad);
+                self.gp_grad.push(geo.gp_grad);
+                self.gp_weight.push(geo.gp_weight);
+            }
+        }
+        Ok(())
+    }
+
+    /// The hourglass scale of a one-point element (see [`Group::hg_scale`]); the physical
+    /// form also keeps the element's frame.
+    fn hourglass_scale(
+        &mut self,
+        hg: Hourglass,
+        pc: &PartConstants,
+        e: u32,
+        x: &[[f64; 3]; 8],
+        geo: &ElementGeometry,
+    ) -> Result<f64, SolverError> {
+        Ok(if hg.form == HourglassForm::Physical {
+            self.frames.push(physical::element_frame(x).ok_or_else(|| {
+                SolverError::Invalid(format!(
+                    "element {e} (part `{}`): no element frame for physical hourglass control (an edge of zero length)",
+                    pc.part.name
+                ))
+            })?);
+            hg.coefficient * geo.volume / 3.0
+        } else if hg.form == HourglassForm::Stiffness {
+            let mut bb = 0.0;
+            for i in 0..3 {
+                for a in 0..8 {
+                    let b = geo.mean_grad[i][a] * geo.volume;
+                    bb += b * b;
+                }
+            }
+            hg.coefficient * pc.hg_modulus * bb / (3.0 * geo.volume) / 64.0
+        } else {
+            // The kernel multiplies by the current wave speed c.
+            hg.coefficient * pc.rho * geo.volume.powf(2.0 / 3.0) * 0.25 * pc.hg_c_ratio
+        })
+    }
+
+    /// Put the reference data in lanes, batch by batch, into the group.
+    fn batch_into(&self, g: &mut Group) {
+        let nodal = |e: &[&Nodal; LANES]| -> Nodal<F64x8> {
+            std::array::from_fn(|i| std::array::from_fn(|a| lanes(|l| e[l][i][a])))
+        };
+        g.grad = batched(&self.grad, nodal);
+        g.gamma = batched(&self.gamma, |e| {
+            std::array::from_fn(|k| std::array::from_fn(|a| lanes(|l| e[l][k][a])))
+        });
+        g.hg_frame = batched(&self.frames, |e| {
+            std::array::from_fn(|i| std::array::from_fn(|j| lanes(|l| e[l].0[i][j])))
+        });
+        g.hg_inv_len = batched(&self.frames, |e| {
+            std::array::from_fn(|j| lanes(|l| e[l].1[j]))
+        });
+        g.gp_grad = batched(&self.gp_grad, |e| {
+            std::array::from_fn(|gp| {
+                std::array::from_fn(|i| std::array::from_fn(|a| lanes(|l| e[l][gp][i][a])))
+            })
+        });
+        g.gp_weight = batched(&self.gp_weight, |e| {
+            std::array::from_fn(|gp| lanes(|l| e[l][gp]))
+        });
     }
 }
 
