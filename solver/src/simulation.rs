@@ -323,37 +323,8 @@ impl Simulation {
         want_stress: bool,
     ) -> Result<Simulation, SolverError> {
         let nn = model.mesh.nodes.len();
-        let mut dof_code = vec![0u32; nn * 3];
-        let mut prescribed = Vec::new();
-        for c in &constraints {
-            if c.dof > 2 {
-                return Err(SolverError::Invalid(
-                    "constraint direction must be x, y or z".into(),
-                ));
-            }
-            let code = match &c.kind {
-                Kinematic::Fixed => 1,
-                k => {
-                    prescribed.push(Prescribed { kind: k.clone() });
-                    (prescribed.len() + 1) as u32
-                }
-            };
-            for &n in &c.nodes {
-                if n as usize >= nn {
-                    return Err(SolverError::Invalid(format!(
-                        "constraint refers to node {n} beyond the mesh"
-                    )));
-                }
-                dof_code[n as usize * 3 + c.dof] = code;
-            }
-        }
-        for l in &loads {
-            if let Some(&n) = l.nodes.iter().find(|&&n| n as usize >= nn) {
-                return Err(SolverError::Invalid(format!(
-                    "load refers to node {n} beyond the mesh"
-                )));
-            }
-        }
+        let (dof_code, prescribed) = dof_codes(&constraints, nn)?;
+        check_loads(&loads, nn)?;
         let gravity_force = settings.gravity.map(|g| {
             model
                 .mass
@@ -362,37 +333,9 @@ impl Simulation {
                 .collect()
         });
         let ne = model.mesh.elements.len();
-        let mut v = initial_velocity.unwrap_or_else(|| vec![[0.0; 3]; nn]);
-        if v.len() != nn {
-            return Err(SolverError::Invalid(
-                "initial velocity has the wrong length".into(),
-            ));
-        }
-        for n in 0..nn {
-            for d in 0..3 {
-                if dof_code[n * 3 + d] == 1 {
-                    v[n][d] = 0.0;
-                }
-            }
-        }
-        let initial_kinetic: f64 = v
-            .iter()
-            .zip(&model.mass)
-            .map(|(v, m)| 0.5 * m * (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]))
-            .sum();
-        let timers = [
-            "element forces",
-            "loads",
-            "contact",
-            "update",
-            "mass scaling",
-        ]
-        .into_iter()
-        .map(|name| StageTime {
-            name,
-            time: Duration::ZERO,
-        })
-        .collect();
+        let v = initial_velocities(initial_velocity, &dof_code, nn)?;
+        let initial_kinetic = kinetic_energy(&v, &model.mass);
+        let timers = stage_timers();
         Ok(Simulation {
             model,
             settings,
@@ -975,4 +918,97 @@ impl Simulation {
             self.relax_alpha = (2.0 * w2.sqrt()).min(1.0 / dt);
         }
     }
+}
+
+/// The code of each degree of freedom (node * 3 + direction) from the kinematic conditions: 0
+/// free, 1 fixed, k + 2 prescribed by the k-th of the returned prescriptions (a later condition
+/// on the same degree of freedom replaces an earlier one).
+fn dof_codes(
+    constraints: &[Constraint],
+    nn: usize,
+) -> Result<(Vec<u32>, Vec<Prescribed>), SolverError> {
+    let mut dof_code = vec![0u32; nn * 3];
+    let mut prescribed = Vec::new();
+    for c in constraints {
+        if c.dof > 2 {
+            return Err(SolverError::Invalid(
+                "constraint direction must be x, y or z".into(),
+            ));
+        }
+        let code = match &c.kind {
+            Kinematic::Fixed => 1,
+            k => {
+                prescribed.push(Prescribed { kind: k.clone() });
+                (prescribed.len() + 1) as u32
+            }
+        };
+        for &n in &c.nodes {
+            if n as usize >= nn {
+                return Err(SolverError::Invalid(format!(
+                    "constraint refers to node {n} beyond the mesh"
+                )));
+            }
+            dof_code[n as usize * 3 + c.dof] = code;
+        }
+    }
+    Ok((dof_code, prescribed))
+}
+
+/// Every load acts on nodes of the mesh (`nn` nodes).
+fn check_loads(loads: &[NodalLoad], nn: usize) -> Result<(), SolverError> {
+    for l in loads {
+        if let Some(&n) = l.nodes.iter().find(|&&n| n as usize >= nn) {
+            return Err(SolverError::Invalid(format!(
+                "load refers to node {n} beyond the mesh"
+            )));
+        }
+    }
+    Ok(())
+}
+
+/// The initial velocities (zero where none are given), zero on fixed degrees of freedom.
+fn initial_velocities(
+    given: Option<Vec<[f64; 3]>>,
+    dof_code: &[u32],
+    nn: usize,
+) -> Result<Vec<[f64; 3]>, SolverError> {
+    let mut v = given.unwrap_or_else(|| vec![[0.0; 3]; nn]);
+    if v.len() != nn {
+        return Err(SolverError::Invalid(
+            "initial velocity has the wrong length".into(),
+        ));
+    }
+    for n in 0..nn {
+        for d in 0..3 {
+            if dof_code[n * 3 + d] == 1 {
+                v[n][d] = 0.0;
+            }
+        }
+    }
+    Ok(v)
+}
+
+/// Kinetic energy of the velocities `v` on the nodal masses (J).
+fn kinetic_energy(v: &[[f64; 3]], mass: &[f64]) -> f64 {
+    v.iter()
+        .zip(mass)
+        .map(|(v, m)| 0.5 * m * (v[0] * v[0] + v[1] * v[1] + v[2] * v[2]))
+        .sum()
+}
+
+/// The stage timers, all at zero, in the order of [`Stage`].
+fn stage_timers() -> Vec<StageTime> {
+    [
+        "element forces",
+        "loads",
+        "contact",
+        "update",
+        "mass scaling",
+    ]
+    .into_iter()
+    .map(|name| StageTime {
+        name,
+        time: Duration::ZERO,
+    })
+    .collect()
 }
