@@ -279,7 +279,7 @@ pub struct Simulation {
     hg_worst: Option<HourglassPeak>,
     scratch_x: Vec<[f64; 3]>,
     scratch_targets: Vec<f64>,
-    scratch_partials: Vec<[f64; 12]>,
+    scratch_partials: Vec<StepSums>,
 }
 
 /// The element with the largest hourglass energy of one step over the run so far.
@@ -782,7 +782,29 @@ impl Simulation {
             self.settings.damping.unwrap_or(0.0)
         };
         let damping = relax || self.settings.damping.is_some();
-        // Kinematic targets evaluated once per prescription.
+        self.kinematic_targets(t, dt);
+        let s = self.integrate(StepParams {
+            dt,
+            dt_old,
+            dt_avg,
+            alpha,
+            damping,
+            relax,
+        });
+        self.book_energies(&s, dt_avg, t);
+        self.residual = if s.f_int2 > 0.0 {
+            (s.residual2 / s.f_int2).sqrt()
+        } else {
+            0.0
+        };
+        if relax {
+            self.relax_alpha = underwood_alpha(&s, dt);
+        }
+    }
+
+    /// The kinematic conditions' targets for the step `dt` from `t`, once per prescription
+    /// (into `scratch_targets`): the velocity at the half step, or the displacement at its end.
+    fn kinematic_targets(&mut self, t: f64, dt: f64) {
         let targets: &mut Vec<f64> = &mut self.scratch_targets;
         targets.clear();
         for p in &self.prescribed {
@@ -792,104 +814,56 @@ impl Simulation {
                 Kinematic::Fixed => 0.0,
             });
         }
-        // Nodes are updated in parallel chunks of fixed size; each chunk's energy sums are
-        // reduced serially in chunk order, so the result is the same for any thread count.
-        // s: 0 w_int_old 1 w_int_new 2 w_ext_old 3 w_ext_new 4 w_damp_old 5 w_damp_new 6 ke
-        // 7 ke_half 8 res2 9 fint2 10 u.f_int 11 u.M.u (10 and 11 only under relaxation)
+    }
+
+    /// The central-difference update of velocities, displacements and reactions, and its sums.
+    /// Nodes are updated in parallel chunks of fixed size; each chunk's sums are reduced
+    /// serially in chunk order, so the result is the same for any thread count.
+    fn integrate(&mut self, p: StepParams) -> StepSums {
         let nn = self.u.len();
         let partials = &mut self.scratch_partials;
         partials.clear();
-        partials.resize(nn.div_ceil(NODE_CHUNK), [0.0; 12]);
-        let (mass, f_int, f_ext) = (&self.model.mass, &self.f_int, &self.f_ext);
-        let (dof_code, prescribed, targets) = (&self.dof_code, &self.prescribed, &*targets);
+        partials.resize(nn.div_ceil(NODE_CHUNK), StepSums::default());
+        let nodal = NodalUpdate {
+            p,
+            mass: &self.model.mass,
+            f_int: &self.f_int,
+            f_ext: &self.f_ext,
+            dof_code: &self.dof_code,
+            prescribed: &self.prescribed,
+            targets: &self.scratch_targets,
+        };
         self.u
             .par_chunks_mut(NODE_CHUNK)
             .zip(self.v.par_chunks_mut(NODE_CHUNK))
             .zip(self.reaction.par_chunks_mut(NODE_CHUNK))
             .zip(partials.par_iter_mut())
             .enumerate()
-            .for_each(|(ci, (((uc, vc), rc), s))| {
-                for k in 0..uc.len() {
-                    let n = ci * NODE_CHUNK + k;
-                    let m = mass[n];
-                    for d in 0..3 {
-                        let v_old = vc[k][d];
-                        let fi = f_int[n][d];
-                        let fe = f_ext[n][d];
-                        let fd = if damping { alpha * m * v_old } else { 0.0 };
-                        let fnet = fe - fi - fd;
-                        let code = dof_code[n * 3 + d];
-                        let (v_new, r) = if code == 0 {
-                            (v_old + dt_avg * fnet / m, 0.0)
-                        } else {
-                            let v_new = match code {
-                                1 => 0.0,
-                                c => {
-                                    let tgt = targets[(c - 2) as usize];
-                                    match prescribed[(c - 2) as usize].kind {
-                                        Kinematic::Displacement(_) => (tgt - uc[k][d]) / dt,
-                                        _ => tgt,
-                                    }
-                                }
-                            };
-                            (v_new, m * (v_new - v_old) / dt_avg - fnet)
-                        };
-                        rc[k][d] = r;
-                        if code == 0 {
-                            s[8] += fnet * fnet;
-                        }
-                        s[9] += fi * fi;
-                        if relax {
-                            let u_n = uc[k][d];
-                            s[10] += u_n * fi;
-                            s[11] += m * u_n * u_n;
-                        }
-                        let h_old = 0.5 * dt_old * v_old;
-                        let h_new = 0.5 * dt * v_new;
-                        s[0] += fi * h_old;
-                        s[1] += fi * h_new;
-                        s[2] += (fe + r) * h_old;
-                        s[3] += (fe + r) * h_new;
-                        s[4] += fd * h_old;
-                        s[5] += fd * h_new;
-                        let vn = 0.5 * (v_old + v_new);
-                        s[6] += 0.5 * m * vn * vn;
-                        s[7] += 0.5 * m * v_new * v_new;
-                        vc[k][d] = v_new;
-                        uc[k][d] += dt * v_new;
-                    }
-                }
-            });
-        let mut s = [0.0f64; 12];
+            .for_each(|(ci, (((uc, vc), rc), s))| nodal.chunk(ci, uc, vc, rc, s));
+        let mut s = StepSums::default();
         for p in partials.iter() {
-            for (a, b) in s.iter_mut().zip(p) {
-                *a += b;
-            }
+            s.add(p);
         }
-        // Energies at t^n.
+        s
+    }
+
+    /// The energies at t^n from the step's sums: the works by the trapezoidal rule, the
+    /// hourglass, bulk-viscous and law dissipation from the element loop's rates, and the
+    /// stages' contact energy and driver work.
+    fn book_energies(&mut self, s: &StepSums, dt_avg: f64, t: f64) {
         let tot = self.totals;
-        let w_int = self.w_int_acc + s[0];
-        let w_ext = self.w_ext_acc + s[2];
-        let w_damp = self.w_damp_acc + s[4];
-        self.w_int_acc = w_int + s[1];
-        self.w_ext_acc = w_ext + s[3];
-        self.w_damp_acc = w_damp + s[5];
+        let w_int = self.w_int_acc + s.w_int_old;
+        let w_ext = self.w_ext_acc + s.w_ext_old;
+        let w_damp = self.w_damp_acc + s.w_damp_old;
+        self.w_int_acc = w_int + s.w_int_new;
+        self.w_ext_acc = w_ext + s.w_ext_new;
+        self.w_damp_acc = w_damp + s.w_damp_new;
+        self.book_hourglass(dt_avg, t);
         let e = &mut self.energy;
-        self.hg_dissipated += tot.hg_power * dt_avg;
-        for g in self.model.groups.iter_mut() {
-            g.hourglass.dissipated += g.hourglass.power * dt_avg;
-        }
-        if tot.hg_peak > self.hg_worst.map_or(0.0, |w| w.energy) {
-            self.hg_worst = Some(HourglassPeak {
-                element: tot.hg_peak_elem,
-                energy: tot.hg_peak,
-                time: t,
-            });
-        }
         e.hourglass = tot.hg_stored + self.hg_dissipated;
         e.bulk_viscous += tot.bulk_power * dt_avg;
         e.law_dissipation += tot.law_dissipation;
-        e.kinetic = s[6];
+        e.kinetic = s.kinetic;
         e.damping = w_damp;
         // w_ext holds the work of the stages' (contact) forces on the body; replace it by the work
         // of the stages' drivers (the indenters' motion), so that the balance
@@ -902,20 +876,22 @@ impl Simulation {
                 .map(|s| s.driver_work() - s.body_work())
                 .sum::<f64>();
         e.internal = w_int - e.hourglass - e.bulk_viscous;
-        self.residual = if s[9] > 0.0 {
-            (s[8] / s[9]).sqrt()
-        } else {
-            0.0
-        };
-        if relax {
-            // Underwood's adaptive damping: critical for the mode the displacement follows,
-            // kept below 1/dt (past that the explicit damping term would overshoot).
-            let w2 = if s[11] > 0.0 {
-                (s[10] / s[11]).max(0.0)
-            } else {
-                0.0
-            };
-            self.relax_alpha = (2.0 * w2.sqrt()).min(1.0 / dt);
+    }
+
+    /// The hourglass power over the step (`dt_avg`), in total and per group, and the
+    /// element with the largest hourglass energy so far (this step's at time `t`).
+    fn book_hourglass(&mut self, dt_avg: f64, t: f64) {
+        let tot = self.totals;
+        self.hg_dissipated += tot.hg_power * dt_avg;
+        for g in self.model.groups.iter_mut() {
+            g.hourglass.dissipated += g.hourglass.power * dt_avg;
+        }
+        if tot.hg_peak > self.hg_worst.map_or(0.0, |w| w.energy) {
+            self.hg_worst = Some(HourglassPeak {
+                element: tot.hg_peak_elem,
+                energy: tot.hg_peak,
+                time: t,
+            });
         }
     }
 }
@@ -1011,4 +987,176 @@ fn stage_timers() -> Vec<StageTime> {
         time: Duration::ZERO,
     })
     .collect()
+}
+
+/// Dynamic relaxation: Underwood's adaptive damping coefficient (1/s) for the next step,
+/// critical for the mode the displacement follows (`w^2 = u.f_int / u.M.u`), kept below
+/// 1/dt (past that the explicit damping term would overshoot).
+fn underwood_alpha(s: &StepSums, dt: f64) -> f64 {
+    let w2 = if s.u_m_u > 0.0 {
+        (s.u_f_int / s.u_m_u).max(0.0)
+    } else {
+        0.0
+    };
+    (2.0 * w2.sqrt()).min(1.0 / dt)
+}
+
+/// The scalars of one nodal update: the steps around t^n and the damping.
+#[derive(Clone, Copy, Debug)]
+struct StepParams {
+    /// The step dt^(n+1/2) about to be taken (s).
+    dt: f64,
+    /// The step dt^(n-1/2) taken last (s).
+    dt_old: f64,
+    /// Their mean, the step of the velocity update (s).
+    dt_avg: f64,
+    /// Mass-proportional damping coefficient (1/s).
+    alpha: f64,
+    /// Whether the damping force is applied.
+    damping: bool,
+    /// Dynamic relaxation: also sum `u.f_int` and `u.M.u`.
+    relax: bool,
+}
+
+/// The sums of the nodal update over one chunk of nodes or all of them: the work of the
+/// internal, external (loads, gravity, contact and constraint reactions) and damping forces
+/// over the half steps before and after t^n, the kinetic energies, and the norms of the
+/// residual and of the dynamic relaxation.
+#[derive(Clone, Copy, Debug, Default)]
+struct StepSums {
+    /// `f_int . dt_old/2 v^(n-1/2)`.
+    w_int_old: f64,
+    /// `f_int . dt/2 v^(n+1/2)`.
+    w_int_new: f64,
+    /// `(f_ext + R) . dt_old/2 v^(n-1/2)`.
+    w_ext_old: f64,
+    /// `(f_ext + R) . dt/2 v^(n+1/2)`.
+    w_ext_new: f64,
+    /// `f_damp . dt_old/2 v^(n-1/2)`.
+    w_damp_old: f64,
+    /// `f_damp . dt/2 v^(n+1/2)`.
+    w_damp_new: f64,
+    /// Kinetic energy at t^n, of `v^n = (v^(n-1/2) + v^(n+1/2)) / 2`.
+    kinetic: f64,
+    /// Kinetic energy of `v^(n+1/2)`.
+    kinetic_half: f64,
+    /// `|f_ext - f_int - f_damp|^2` over the free degrees of freedom.
+    residual2: f64,
+    /// `|f_int|^2`.
+    f_int2: f64,
+    /// `u . f_int` (dynamic relaxation only).
+    u_f_int: f64,
+    /// `u . M u` (dynamic relaxation only).
+    u_m_u: f64,
+}
+
+impl StepSums {
+    /// Add the sums of another chunk.
+    fn add(&mut self, o: &StepSums) {
+        self.w_int_old += o.w_int_old;
+        self.w_int_new += o.w_int_new;
+        self.w_ext_old += o.w_ext_old;
+        self.w_ext_new += o.w_ext_new;
+        self.w_damp_old += o.w_damp_old;
+        self.w_damp_new += o.w_damp_new;
+        self.kinetic += o.kinetic;
+        self.kinetic_half += o.kinetic_half;
+        self.residual2 += o.residual2;
+        self.f_int2 += o.f_int2;
+        self.u_f_int += o.u_f_int;
+        self.u_m_u += o.u_m_u;
+    }
+}
+
+/// What the nodal update reads, shared by its parallel chunks.
+struct NodalUpdate<'a> {
+    p: StepParams,
+    mass: &'a [f64],
+    f_int: &'a [[f64; 3]],
+    f_ext: &'a [[f64; 3]],
+    dof_code: &'a [u32],
+    prescribed: &'a [Prescribed],
+    /// Each prescription's target this step (see [`Simulation::kinematic_targets`]).
+    targets: &'a [f64],
+}
+
+impl NodalUpdate<'_> {
+    /// Update the nodes of chunk `ci` (their displacements `uc`, velocities `vc` and reactions
+    /// `rc`), node by node and direction by direction, adding to the chunk's sums `s`.
+    fn chunk(
+        &self,
+        ci: usize,
+        uc: &mut [[f64; 3]],
+        vc: &mut [[f64; 3]],
+        rc: &mut [[f64; 3]],
+        s: &mut StepSums,
+    ) {
+        for k in 0..uc.len() {
+            let n = ci * NODE_CHUNK + k;
+            let m = self.mass[n];
+            for d in 0..3 {
+                rc[k][d] = self.dof(n, d, m, &mut uc[k][d], &mut vc[k][d], s);
+            }
+        }
+    }
+
+    /// Direction `d` of node `n` (mass `m`): the new velocity `v` (from the net force, or
+    /// imposed by a kinematic condition) and displacement `u`, and the sums; returns the
+    /// reaction of the kinematic condition (0 on a free degree of freedom).
+    #[inline]
+    fn dof(&self, n: usize, d: usize, m: f64, u: &mut f64, v: &mut f64, s: &mut StepSums) -> f64 {
+        let p = &self.p;
+        let v_old = *v;
+        let fi = self.f_int[n][d];
+        let fe = self.f_ext[n][d];
+        let fd = if p.damping { p.alpha * m * v_old } else { 0.0 };
+        let fnet = fe - fi - fd;
+        let code = self.dof_code[n * 3 + d];
+        let (v_new, r) = if code == 0 {
+            (v_old + p.dt_avg * fnet / m, 0.0)
+        } else {
+            let v_new = self.imposed_velocity(code, *u);
+            (v_new, m * (v_new - v_old) / p.dt_avg - fnet)
+        };
+        if code == 0 {
+            s.residual2 += fnet * fnet;
+        }
+        s.f_int2 += fi * fi;
+        if p.relax {
+            let u_n = *u;
+            s.u_f_int += u_n * fi;
+            s.u_m_u += m * u_n * u_n;
+        }
+        let h_old = 0.5 * p.dt_old * v_old;
+        let h_new = 0.5 * p.dt * v_new;
+        s.w_int_old += fi * h_old;
+        s.w_int_new += fi * h_new;
+        s.w_ext_old += (fe + r) * h_old;
+        s.w_ext_new += (fe + r) * h_new;
+        s.w_damp_old += fd * h_old;
+        s.w_damp_new += fd * h_new;
+        let vn = 0.5 * (v_old + v_new);
+        s.kinetic += 0.5 * m * vn * vn;
+        s.kinetic_half += 0.5 * m * v_new * v_new;
+        *v = v_new;
+        *u += p.dt * v_new;
+        r
+    }
+
+    /// The velocity v^(n+1/2) the kinematic condition `code` (1 fixed, k + 2 the k-th
+    /// prescription) imposes on a degree of freedom at displacement `u`: zero, the prescribed
+    /// velocity, or the velocity that lands on the prescribed displacement.
+    #[inline]
+    fn imposed_velocity(&self, code: u32, u: f64) -> f64 {
+        match code {
+            1 => 0.0,
+            c => {
+                let tgt = self.targets[(c - 2) as usize];
+                match self.prescribed[(c - 2) as usize].kind {
+                    Kinematic::Displacement(_) => (tgt - u) / self.p.dt,
+                    _ => tgt,
+                }
+            }
+        }
+    }
 }
