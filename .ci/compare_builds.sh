@@ -11,6 +11,7 @@
 #   palpa run scenes/finger-press.toml --out OUT/finger-press
 #   palpa verify --out OUT/verify
 #   palpa campaign scenes/campaign-quick.toml --out OUT/campaign-quick --quiet
+#   palpa palpate --out OUT/palpate          (the main job, about a minute on 2 cores)
 #
 # Files that hold wall times or dates are compared without them (everything else in them
 # must match to the bit):
@@ -25,7 +26,7 @@
 set -euo pipefail
 
 if [[ $# -lt 1 || $# -gt 2 || $1 == -h || $1 == --help ]]; then
-    sed -n '2,25p' "$0" | sed 's/^# \{0,1\}//'
+    sed -n '2,26p' "$0" | sed 's/^# \{0,1\}//'
     exit 2
 fi
 repo=$(git rev-parse --show-toplevel)
@@ -81,6 +82,7 @@ run_side() {
     run_one finger-press run scenes/finger-press.toml --out ../out/finger-press --quiet
     run_one verify verify --out ../out/verify
     run_one campaign-quick campaign scenes/campaign-quick.toml --out ../out/campaign-quick --quiet
+    run_one palpate palpate --out ../out/palpate
     cd "$repo"
 }
 
