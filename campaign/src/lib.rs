@@ -4,7 +4,7 @@
 //! A campaign is a [`CampaignSpec`] (a TOML file, or the paper's protocol when none is given)
 //! resolved into a [`Campaign`]: a list of locations, each labelled train or test, and a list of
 //! [`PlannedRun`]s, the product of locations x depths x durations in a fixed order. Every run is
-//! an ordinary palpation ([`PalpationSetup`]) written as `scene.toml` into its own directory
+//! an ordinary palpation ([`scene::palpation::PalpationSetup`]) written as `scene.toml` into its own directory
 //! `DIR/runs/<label>/` and run there; a run is finished when its `done.json` ([`DoneMarker`])
 //! exists, written atomically after everything else. A directory without it is an interrupted or
 //! failed run and is redone from scratch.

@@ -1,4 +1,8 @@
-//! Scenes: the TOML file a user writes, and its translation into a runnable [`Simulation`].
+//! Scenes: the TOML file a user writes ([`SceneSpec`]), its translation into a runnable
+//! simulation ([`build`]: node sets, parts, constraints and loads, the output plan, loop
+//! settings, contact through [`contact_build`]), the run loop that drives it to its end and
+//! writes the summary ([`run`]), the pilot of `palpa check` ([`pilot`]), and the palpation scene
+//! built in memory ([`palpation`]).
 //!
 //! Errors name the file, and where possible the line and key: toml reports the line and key of
 //! a syntax error, an unknown key or a wrong unit; checks after parsing (an unknown node set, an

@@ -131,9 +131,9 @@ pub fn plan(path: &Path, real: &Scene) -> Result<PilotPlan, String> {
 /// Where along the run the pilot's shapes are measured.
 const SAMPLES: usize = 200;
 
-/// Run the pilot to the end time and estimate the steps of `real`. At [`SAMPLES`] evenly
+/// Run the pilot to the end time and estimate the steps of `real`. At `SAMPLES` evenly
 /// spaced times the pilot's shapes are measured with
-/// [`isochoric_step_at`](solver::model::isochoric_step_at): each element's length at its
+/// [`solver::model::isochoric_step_at`]: each element's length at its
 /// reference volume and the run's initial wave speed. The run's laws are not evaluated there:
 /// on the pilot's few per cent of volume change they would give the run's bulk modulus a
 /// pressure it never sees.

@@ -24,7 +24,7 @@ use material::Law;
 
 /// Reference data of one fully integrated element (or of one batch, one element per lane).
 pub struct FullRef<'a, R: Real = f64> {
-    /// Mean gradient [component][node] (1/m).
+    /// Mean gradient, `[component][node]` (1/m).
     pub centre_grad: &'a Nodal<R>,
     /// Gauss-point gradients.
     pub gp_grad: &'a [Nodal<R>; 8],

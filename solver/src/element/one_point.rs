@@ -16,7 +16,7 @@ use material::Law;
 
 /// Reference data of one one-point element (or of one batch, one element per lane).
 pub struct OnePointRef<'a, R: Real = f64> {
-    /// Mean gradient [component][node] (1/m).
+    /// Mean gradient, `[component][node]` (1/m).
     pub grad: &'a Nodal<R>,
     /// Hourglass shape vectors.
     pub gamma: &'a [[R; 8]; 4],
