@@ -3,11 +3,13 @@
 //!
 //! A campaign is a [`CampaignSpec`] (a TOML file, or the paper's protocol when none is given)
 //! resolved into a [`Campaign`]: a list of locations, each labelled train or test, and a list of
-//! [`PlannedRun`]s, the product of locations x depths x durations in a fixed order. Every run is
-//! an ordinary palpation ([`scene::palpation::PalpationSetup`]) written as `scene.toml` into its own directory
-//! `DIR/runs/<label>/` and run there; a run is finished when its `done.json` ([`DoneMarker`])
-//! exists, written atomically after everything else. A directory without it is an interrupted or
-//! failed run and is redone from scratch.
+//! [`PlannedRun`]s, the product of locations x depths x durations in a fixed order. On its built
+//! phantom it has a [`CampaignPlan`], which `campaign.json` records. Every run is an ordinary
+//! palpation ([`scene::palpation::PalpationSetup`]), built in memory, its `scene.toml` written
+//! into its own directory `DIR/runs/<label>/` and run there ([`execute`]); a run is finished
+//! when its `done.json` ([`DoneMarker`]) exists, written atomically after everything else. A
+//! directory without it is an interrupted or failed run and is redone from scratch. The
+//! finished runs make the dataset ([`assemble`]); the shards of a campaign join by [`merge`].
 //!
 //! # The file
 //! Every key is optional; the defaults are the paper's protocol (`docs/paper.md`):
