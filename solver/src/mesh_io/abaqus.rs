@@ -139,284 +139,447 @@ impl Members {
     }
 }
 
+/// `file:line` of a line, for messages.
+fn at(l: &Line) -> String {
+    format!("{}:{}", l.file.display(), l.no)
+}
+
+/// One data line of a keyword (continuation lines joined): the line it starts on and its
+/// comma-separated fields, empty fields left out.
+struct DataLine<'a> {
+    line: &'a Line,
+    fields: Vec<String>,
+}
+
+impl DataLine<'_> {
+    /// Field `k` as a number; `what` names it in the error.
+    fn num(&self, k: usize, what: &str) -> Result<f64, String> {
+        let s = self
+            .fields
+            .get(k)
+            .ok_or_else(|| format!("{}: {what} missing", at(self.line)))?;
+        s.parse::<f64>()
+            .map_err(|_| format!("{}: {what} `{s}` is not a number", at(self.line)))
+    }
+
+    /// Field `k` as an integer label; `what` names it in the error.
+    fn label(&self, k: usize, what: &str) -> Result<i64, String> {
+        let s = self
+            .fields
+            .get(k)
+            .ok_or_else(|| format!("{}: {what} missing", at(self.line)))?;
+        s.parse::<i64>()
+            .map_err(|_| format!("{}: {what} `{s}` is not an integer label", at(self.line)))
+    }
+}
+
+/// The data lines from line `i` up to the next keyword line, joined where a line ends in a
+/// comma, and the index of that keyword line.
+fn data_lines(lines: &[Line], mut i: usize) -> (Vec<DataLine<'_>>, usize) {
+    let mut data = Vec::new();
+    while i < lines.len() && !lines[i].text.starts_with('*') {
+        let first = &lines[i];
+        let mut text = first.text.clone();
+        while text.trim_end().ends_with(',')
+            && i + 1 < lines.len()
+            && !lines[i + 1].text.starts_with('*')
+        {
+            i += 1;
+            text.push_str(&lines[i].text);
+        }
+        let fields = text
+            .split(',')
+            .map(|s| s.trim().to_string())
+            .filter(|s| !s.is_empty())
+            .collect();
+        data.push(DataLine {
+            line: first,
+            fields,
+        });
+        i += 1;
+    }
+    (data, i)
+}
+
+/// The labels in the first field of each data line (those that are integers).
+fn first_labels<'a>(data: &'a [DataLine]) -> impl Iterator<Item = i64> + 'a {
+    data.iter().filter_map(|d| d.fields[0].parse::<i64>().ok())
+}
+
+/// One keyword line and its data lines.
+struct Keyword<'a> {
+    /// The keyword line.
+    line: &'a Line,
+    /// Its text after the `*`.
+    text: &'a str,
+    /// Its lower-case name.
+    name: String,
+    /// Its parameters (lower-case names).
+    params: BTreeMap<String, String>,
+    data: Vec<DataLine<'a>>,
+}
+
+/// What the parser has read so far, keyword by keyword.
+#[derive(Default)]
+struct Parser {
+    raw: RawMesh,
+    node_index: BTreeMap<i64, u32>,
+    /// The *Element elset of each hexahedron.
+    hex_elset: Vec<Option<String>>,
+    elem_index: BTreeMap<i64, u32>,
+    /// The label of each hexahedron.
+    hex_ids: Vec<i64>,
+    nsets: BTreeMap<String, Members>,
+    elsets: BTreeMap<String, Members>,
+    /// `*Solid Section`s: (elset, where).
+    sections: Vec<(String, String)>,
+    parts_seen: usize,
+    instances: usize,
+    /// Inside *Assembly ... *End Assembly.
+    in_assembly: bool,
+    /// Inside *Instance ... *End Instance.
+    in_instance: bool,
+    skipped_nodes: usize,
+    skipped_sets: Vec<String>,
+    /// Where each node set was (first) defined, for messages.
+    nset_at: BTreeMap<String, String>,
+}
+
+/// The mesh that the lines of an input file (includes read in) state, keyword by keyword.
 fn parse(lines: &[Line]) -> Result<RawMesh, String> {
-    let at = |l: &Line| format!("{}:{}", l.file.display(), l.no);
-    let mut raw = RawMesh::default();
-    let mut node_index: BTreeMap<i64, u32> = BTreeMap::new();
-    // The *Element elset of each hexahedron.
-    let mut hex_elset: Vec<Option<String>> = Vec::new();
-    let mut elem_index: BTreeMap<i64, u32> = BTreeMap::new();
-    // The label of each hexahedron.
-    let mut hex_ids: Vec<i64> = Vec::new();
-    let mut nsets: BTreeMap<String, Members> = BTreeMap::new();
-    let mut elsets: BTreeMap<String, Members> = BTreeMap::new();
-    let mut sections: Vec<(String, String)> = Vec::new(); // (elset, where)
-    let mut parts_seen = 0;
-    let mut instances = 0;
-    // Inside *Assembly ... *End Assembly, and inside *Instance ... *End Instance.
-    let (mut in_assembly, mut in_instance) = (false, false);
-    let mut skipped_nodes = 0usize;
-    let mut skipped_sets: Vec<String> = Vec::new();
-    // Where each node set was (first) defined, for messages.
-    let mut nset_at: BTreeMap<String, String> = BTreeMap::new();
+    let mut p = Parser::default();
     let mut i = 0;
     while i < lines.len() {
         let l = &lines[i];
-        let Some(kw) = l.text.strip_prefix('*') else {
+        let Some(text) = l.text.strip_prefix('*') else {
             return Err(format!(
                 "{}: data line `{}` outside a keyword that takes data",
                 at(l),
                 l.text
             ));
         };
-        let (name, params) = keyword(kw);
-        // The data lines of this keyword, joined where a line ends in a comma.
-        let mut data: Vec<(&Line, Vec<String>)> = Vec::new();
-        i += 1;
-        while i < lines.len() && !lines[i].text.starts_with('*') {
-            let first = &lines[i];
-            let mut text = first.text.clone();
-            while text.trim_end().ends_with(',')
-                && i + 1 < lines.len()
-                && !lines[i + 1].text.starts_with('*')
-            {
-                i += 1;
-                text.push_str(&lines[i].text);
-            }
-            let fields = text
-                .split(',')
-                .map(|s| s.trim().to_string())
-                .filter(|s| !s.is_empty())
-                .collect();
-            data.push((first, fields));
-            i += 1;
-        }
-        let num = |d: &(&Line, Vec<String>), k: usize, what: &str| -> Result<f64, String> {
-            let s =
-                d.1.get(k)
-                    .ok_or_else(|| format!("{}: {what} missing", at(d.0)))?;
-            s.parse::<f64>()
-                .map_err(|_| format!("{}: {what} `{s}` is not a number", at(d.0)))
-        };
-        let label = |d: &(&Line, Vec<String>), k: usize, what: &str| -> Result<i64, String> {
-            let s =
-                d.1.get(k)
-                    .ok_or_else(|| format!("{}: {what} missing", at(d.0)))?;
-            s.parse::<i64>()
-                .map_err(|_| format!("{}: {what} `{s}` is not an integer label", at(d.0)))
-        };
-        match name.as_str() {
+        let (name, params) = keyword(text);
+        let (data, next) = data_lines(lines, i + 1);
+        i = next;
+        p.keyword(&Keyword {
+            line: l,
+            text,
+            name,
+            params,
+            data,
+        })?;
+    }
+    p.finish()
+}
+
+impl Parser {
+    /// Take one keyword: structure (`*Part`, `*Assembly`, `*Instance`), nodes, elements, sets
+    /// and sections; anything else is skipped.
+    fn keyword(&mut self, k: &Keyword) -> Result<(), String> {
+        let assembly_level = self.in_assembly && !self.in_instance;
+        match k.name.as_str() {
             "part" => {
-                parts_seen += 1;
-                if parts_seen > 1 {
+                self.parts_seen += 1;
+                if self.parts_seen > 1 {
                     return Err(format!(
                         "{}: a second *Part; palpa reads one part (or a flat input file without parts)",
-                        at(l)
+                        at(k.line)
                     ));
                 }
             }
-            "assembly" => in_assembly = true,
-            "end assembly" => in_assembly = false,
-            "end instance" => in_instance = false,
-            "node" if in_assembly && !in_instance => skipped_nodes += data.len(),
-            "nset" if in_assembly && !in_instance && !params.contains_key("instance") => {
-                if let Some(n) = params.get("nset") {
-                    skipped_sets.push(n.clone());
+            "assembly" => self.in_assembly = true,
+            "end assembly" => self.in_assembly = false,
+            "end instance" => self.in_instance = false,
+            "node" if assembly_level => self.skipped_nodes += k.data.len(),
+            "nset" if assembly_level && !k.params.contains_key("instance") => {
+                if let Some(n) = k.params.get("nset") {
+                    self.skipped_sets.push(n.clone());
                 }
             }
-            "instance" => {
-                in_instance = true;
-                instances += 1;
-                if instances > 1 {
-                    return Err(format!(
-                        "{}: a second *Instance; palpa reads one instance of one part",
-                        at(l)
-                    ));
-                }
-                if !data.is_empty() {
-                    return Err(format!(
-                        "{}: *Instance with a translation or rotation; palpa reads the part where it is \
-                         (apply the transformation to the part's nodes, or write a flat input file)",
-                        at(l)
-                    ));
-                }
-            }
-            "node" => {
-                for d in &data {
-                    let id = label(d, 0, "node label")?;
-                    if d.1.len() < 4 {
-                        return Err(format!(
-                            "{}: node {id} has no z coordinate; palpa reads 3-D meshes",
-                            at(d.0)
-                        ));
-                    }
-                    let x = [num(d, 1, "x")?, num(d, 2, "y")?, num(d, 3, "z")?];
-                    if node_index.insert(id, raw.nodes.len() as u32).is_some() {
-                        return Err(format!("{}: node {id} is defined twice", at(d.0)));
-                    }
-                    raw.nodes.push(x);
-                    raw.node_ids.push(id);
-                }
-                if let Some(s) = params.get("nset") {
-                    nset_at.entry(s.to_string()).or_insert_with(|| at(l));
-                    let ids = data.iter().filter_map(|d| d.1[0].parse::<i64>().ok());
-                    nsets.entry(s.to_string()).or_default().labels.extend(ids);
-                }
-            }
-            "element" => {
-                let ty = params
-                    .get("type")
-                    .ok_or_else(|| format!("{}: *Element without type=", at(l)))?
-                    .to_ascii_uppercase();
-                let hex = ty.starts_with("C3D8");
-                let volume = ty.starts_with("C3D") || ty.starts_with("DC3D");
-                let elset = params.get("elset").cloned();
-                for d in &data {
-                    let id = label(d, 0, "element label")?;
-                    if hex {
-                        if d.1.len() != 9 {
-                            return Err(format!(
-                                "{}: {ty} element {id} has {} nodes; C3D8 elements have 8",
-                                at(d.0),
-                                d.1.len() - 1
-                            ));
-                        }
-                        let mut h = [0u32; 8];
-                        for (k, slot) in h.iter_mut().enumerate() {
-                            let n = label(d, k + 1, "node label")?;
-                            *slot = *node_index.get(&n).ok_or_else(|| {
-                                format!(
-                                    "{}: element {id} refers to node {n}, which no *Node above defines",
-                                    at(d.0)
-                                )
-                            })?;
-                        }
-                        if elem_index.insert(id, raw.hexes.len() as u32).is_some() {
-                            return Err(format!("{}: element {id} is defined twice", at(d.0)));
-                        }
-                        raw.hexes.push(h);
-                        hex_ids.push(id);
-                        raw.hex_labels.push(format!(
-                            "element {id} ({}:{})",
-                            d.0.file.display(),
-                            d.0.no
-                        ));
-                        hex_elset.push(elset.clone());
-                    } else if volume {
-                        *raw.other_volume
-                            .entry(format!("{ty} elements"))
-                            .or_default() += 1;
-                    } else {
-                        *raw.other_lower.entry(format!("{ty} elements")).or_default() += 1;
-                    }
-                }
-                if let (Some(s), true) = (&elset, hex) {
-                    let ids = data.iter().filter_map(|d| d.1[0].parse::<i64>().ok());
-                    elsets.entry(s.clone()).or_default().labels.extend(ids);
-                }
-            }
-            "nset" | "elset" => {
-                let key = if name == "nset" { "nset" } else { "elset" };
-                let set = params
-                    .get(key)
-                    .ok_or_else(|| {
-                        format!(
-                            "{}: *{} without {key}=",
-                            at(l),
-                            kw.split(',').next().unwrap_or("")
-                        )
-                    })?
-                    .clone();
-                let generate = params.contains_key("generate");
-                let mut members = Members::default();
-                // the sets this keyword lists, each merged once
-                let mut listed: BTreeSet<&str> = BTreeSet::new();
-                for d in &data {
-                    if generate {
-                        let a = label(d, 0, "first label")?;
-                        let b = label(d, 1, "last label")?;
-                        let s = if d.1.len() > 2 {
-                            label(d, 2, "increment")?
-                        } else {
-                            1
-                        };
-                        if s <= 0 || b < a {
-                            return Err(format!(
-                                "{}: generate `{a}, {b}, {s}` is empty or runs backwards",
-                                at(d.0)
-                            ));
-                        }
-                        members.ranges.insert((a, b, s));
-                    } else {
-                        for tok in &d.1 {
-                            match tok.parse::<i64>() {
-                                Ok(v) => {
-                                    members.labels.insert(v);
-                                }
-                                Err(_) => {
-                                    if !listed.insert(tok.as_str()) {
-                                        continue;
-                                    }
-                                    let sets = if key == "nset" { &nsets } else { &elsets };
-                                    let other = sets.iter().find(|(k, _)| k.eq_ignore_ascii_case(tok)).map(|(_, v)| v).ok_or_else(|| {
-                                        format!("{}: `{tok}` is neither a label nor a set defined above", at(d.0))
-                                    })?;
-                                    members.add(other);
-                                }
-                            }
-                        }
-                    }
-                }
-                let sets = if key == "nset" {
-                    nset_at.entry(set.clone()).or_insert_with(|| at(l));
-                    &mut nsets
-                } else {
-                    &mut elsets
-                };
-                sets.entry(set).or_default().add(&members);
-            }
+            "instance" => self.instance(k)?,
+            "node" => self.nodes(k)?,
+            "element" => self.elements(k)?,
+            "nset" | "elset" => self.set(k)?,
             "solid section" => {
-                let e = params
+                let e = k
+                    .params
                     .get("elset")
-                    .ok_or_else(|| format!("{}: *Solid Section without elset=", at(l)))?;
-                sections.push((e.clone(), at(l)));
+                    .ok_or_else(|| format!("{}: *Solid Section without elset=", at(k.line)))?;
+                self.sections.push((e.clone(), at(k.line)));
             }
             _ => {}
         }
+        Ok(())
     }
-    if skipped_nodes > 0 {
-        raw.notes.push(format!(
-            "{skipped_nodes} node(s) at the assembly level (reference points) skipped{}",
-            if skipped_sets.is_empty() {
-                String::new()
-            } else {
-                format!(", with the node set(s) {}", skipped_sets.join(", "))
-            }
-        ));
-    }
-    // Sets: labels -> indices; element sets keep hexahedra only.
-    for (name, m) in &nsets {
-        let v = m.resolve(&node_index, true).map_err(|id| {
-            let at = nset_at
-                .get(name)
-                .map_or(String::new(), |w| format!("{w}: "));
-            format!("{at}node set `{name}` lists node {id}, which no *Node defines")
-        })?;
-        raw.node_sets.insert(name.clone(), v);
-    }
-    let mut hex_sets: BTreeMap<&str, Vec<u32>> = BTreeMap::new();
-    for (name, m) in &elsets {
-        let v = m.resolve(&elem_index, false).unwrap_or_default();
-        if !v.is_empty() {
-            raw.element_sets.insert(name.clone(), v.clone());
+
+    /// `*Instance`: one, without a translation or rotation.
+    fn instance(&mut self, k: &Keyword) -> Result<(), String> {
+        self.in_instance = true;
+        self.instances += 1;
+        if self.instances > 1 {
+            return Err(format!(
+                "{}: a second *Instance; palpa reads one instance of one part",
+                at(k.line)
+            ));
         }
-        hex_sets.insert(name, v);
+        if !k.data.is_empty() {
+            return Err(format!(
+                "{}: *Instance with a translation or rotation; palpa reads the part where it is \
+                 (apply the transformation to the part's nodes, or write a flat input file)",
+                at(k.line)
+            ));
+        }
+        Ok(())
     }
-    // Parts.
-    let mut part_of: Vec<Option<usize>> = vec![None; raw.hexes.len()];
-    let mut names: Vec<String> = Vec::new();
-    if !sections.is_empty() {
-        for (elset, where_) in &sections {
+
+    /// `*Node`: label, x, y, z per line; `nset=` adds the nodes to a set.
+    fn nodes(&mut self, k: &Keyword) -> Result<(), String> {
+        for d in &k.data {
+            let id = d.label(0, "node label")?;
+            if d.fields.len() < 4 {
+                return Err(format!(
+                    "{}: node {id} has no z coordinate; palpa reads 3-D meshes",
+                    at(d.line)
+                ));
+            }
+            let x = [d.num(1, "x")?, d.num(2, "y")?, d.num(3, "z")?];
+            if self
+                .node_index
+                .insert(id, self.raw.nodes.len() as u32)
+                .is_some()
+            {
+                return Err(format!("{}: node {id} is defined twice", at(d.line)));
+            }
+            self.raw.nodes.push(x);
+            self.raw.node_ids.push(id);
+        }
+        if let Some(s) = k.params.get("nset") {
+            self.nset_at
+                .entry(s.to_string())
+                .or_insert_with(|| at(k.line));
+            let ids = first_labels(&k.data);
+            self.nsets
+                .entry(s.to_string())
+                .or_default()
+                .labels
+                .extend(ids);
+        }
+        Ok(())
+    }
+
+    /// `*Element`: hexahedra (C3D8...) are read, other volume elements and lower-dimensional
+    /// ones counted; `elset=` puts the hexahedra in a set.
+    fn elements(&mut self, k: &Keyword) -> Result<(), String> {
+        let ty = k
+            .params
+            .get("type")
+            .ok_or_else(|| format!("{}: *Element without type=", at(k.line)))?
+            .to_ascii_uppercase();
+        let hex = ty.starts_with("C3D8");
+        let volume = ty.starts_with("C3D") || ty.starts_with("DC3D");
+        let elset = k.params.get("elset").cloned();
+        for d in &k.data {
+            let id = d.label(0, "element label")?;
+            if hex {
+                self.hex(d, id, &ty, &elset)?;
+            } else if volume {
+                *self
+                    .raw
+                    .other_volume
+                    .entry(format!("{ty} elements"))
+                    .or_default() += 1;
+            } else {
+                *self
+                    .raw
+                    .other_lower
+                    .entry(format!("{ty} elements"))
+                    .or_default() += 1;
+            }
+        }
+        if let (Some(s), true) = (&elset, hex) {
+            let ids = first_labels(&k.data);
+            self.elsets.entry(s.clone()).or_default().labels.extend(ids);
+        }
+        Ok(())
+    }
+
+    /// One hexahedron (label `id`, type `ty`, in the `*Element`'s `elset`) from its data line.
+    fn hex(
+        &mut self,
+        d: &DataLine,
+        id: i64,
+        ty: &str,
+        elset: &Option<String>,
+    ) -> Result<(), String> {
+        if d.fields.len() != 9 {
+            return Err(format!(
+                "{}: {ty} element {id} has {} nodes; C3D8 elements have 8",
+                at(d.line),
+                d.fields.len() - 1
+            ));
+        }
+        let mut h = [0u32; 8];
+        for (k, slot) in h.iter_mut().enumerate() {
+            let n = d.label(k + 1, "node label")?;
+            *slot = *self.node_index.get(&n).ok_or_else(|| {
+                format!(
+                    "{}: element {id} refers to node {n}, which no *Node above defines",
+                    at(d.line)
+                )
+            })?;
+        }
+        if self
+            .elem_index
+            .insert(id, self.raw.hexes.len() as u32)
+            .is_some()
+        {
+            return Err(format!("{}: element {id} is defined twice", at(d.line)));
+        }
+        self.raw.hexes.push(h);
+        self.hex_ids.push(id);
+        self.raw.hex_labels.push(format!(
+            "element {id} ({}:{})",
+            d.line.file.display(),
+            d.line.no
+        ));
+        self.hex_elset.push(elset.clone());
+        Ok(())
+    }
+
+    /// `*Nset` or `*Elset`: labels, `generate` ranges or sets defined above, added to the set.
+    fn set(&mut self, k: &Keyword) -> Result<(), String> {
+        let key = if k.name == "nset" { "nset" } else { "elset" };
+        let set = k
+            .params
+            .get(key)
+            .ok_or_else(|| {
+                format!(
+                    "{}: *{} without {key}=",
+                    at(k.line),
+                    k.text.split(',').next().unwrap_or("")
+                )
+            })?
+            .clone();
+        let members = if k.params.contains_key("generate") {
+            generated_members(&k.data)?
+        } else {
+            self.listed_members(key, &k.data)?
+        };
+        let sets = if key == "nset" {
+            self.nset_at
+                .entry(set.clone())
+                .or_insert_with(|| at(k.line));
+            &mut self.nsets
+        } else {
+            &mut self.elsets
+        };
+        sets.entry(set).or_default().add(&members);
+        Ok(())
+    }
+
+    /// The members that a set's data lines list: labels, and the sets of kind `key` (`nset`
+    /// or `elset`) defined above, each merged once.
+    fn listed_members(&self, key: &str, data: &[DataLine]) -> Result<Members, String> {
+        let mut members = Members::default();
+        // the sets this keyword lists, each merged once
+        let mut listed: BTreeSet<&str> = BTreeSet::new();
+        for d in data {
+            for tok in &d.fields {
+                match tok.parse::<i64>() {
+                    Ok(v) => {
+                        members.labels.insert(v);
+                    }
+                    Err(_) => {
+                        if !listed.insert(tok.as_str()) {
+                            continue;
+                        }
+                        let sets = if key == "nset" {
+                            &self.nsets
+                        } else {
+                            &self.elsets
+                        };
+                        let other = sets
+                            .iter()
+                            .find(|(k, _)| k.eq_ignore_ascii_case(tok))
+                            .map(|(_, v)| v)
+                            .ok_or_else(|| {
+                                format!(
+                                    "{}: `{tok}` is neither a label nor a set defined above",
+                                    at(d.line)
+                                )
+                            })?;
+                        members.add(other);
+                    }
+                }
+            }
+        }
+        Ok(members)
+    }
+
+    /// The report's note on what was skipped at the assembly level.
+    fn note_skipped(&mut self) {
+        if self.skipped_nodes > 0 {
+            self.raw.notes.push(format!(
+                "{} node(s) at the assembly level (reference points) skipped{}",
+                self.skipped_nodes,
+                if self.skipped_sets.is_empty() {
+                    String::new()
+                } else {
+                    format!(", with the node set(s) {}", self.skipped_sets.join(", "))
+                }
+            ));
+        }
+    }
+
+    /// The mesh: notes, sets resolved to indices, and parts.
+    fn finish(mut self) -> Result<RawMesh, String> {
+        self.note_skipped();
+        self.resolve_node_sets()?;
+        let hex_sets = self.resolve_element_sets();
+        let (part_of, names) = self.section_parts(&hex_sets)?;
+        self.assign_parts(&part_of, names);
+        Ok(self.raw)
+    }
+
+    /// Node sets: labels -> indices; a label no `*Node` defines is an error.
+    fn resolve_node_sets(&mut self) -> Result<(), String> {
+        for (name, m) in &self.nsets {
+            let v = m.resolve(&self.node_index, true).map_err(|id| {
+                let at = self
+                    .nset_at
+                    .get(name)
+                    .map_or(String::new(), |w| format!("{w}: "));
+                format!("{at}node set `{name}` lists node {id}, which no *Node defines")
+            })?;
+            self.raw.node_sets.insert(name.clone(), v);
+        }
+        Ok(())
+    }
+
+    /// Element sets: labels -> indices of hexahedra (other elements left out); the mesh keeps
+    /// the sets that hold any. Returns every set's hexahedra by name.
+    fn resolve_element_sets(&mut self) -> BTreeMap<String, Vec<u32>> {
+        let mut hex_sets: BTreeMap<String, Vec<u32>> = BTreeMap::new();
+        for (name, m) in &self.elsets {
+            let v = m.resolve(&self.elem_index, false).unwrap_or_default();
+            if !v.is_empty() {
+                self.raw.element_sets.insert(name.clone(), v.clone());
+            }
+            hex_sets.insert(name.clone(), v);
+        }
+        hex_sets
+    }
+
+    /// The part of each hexahedron from the `*Solid Section`s (None where no section holds
+    /// it), and the parts' names (the sections' element sets); an element in two sections is
+    /// an error.
+    fn section_parts(
+        &self,
+        hex_sets: &BTreeMap<String, Vec<u32>>,
+    ) -> Result<(Vec<Option<usize>>, Vec<String>), String> {
+        let mut part_of: Vec<Option<usize>> = vec![None; self.raw.hexes.len()];
+        let mut names: Vec<String> = Vec::new();
+        for (elset, where_) in &self.sections {
             let hexes = hex_sets
                 .iter()
                 .find(|(k, _)| k.eq_ignore_ascii_case(elset))
@@ -433,37 +596,67 @@ fn parse(lines: &[Line]) -> Result<RawMesh, String> {
                     }
                     return Err(format!(
                         "{where_}: element {} is in two solid sections (`{}` and `{elset}`)",
-                        hex_ids[e as usize], names[prev]
+                        self.hex_ids[e as usize], names[prev]
                     ));
                 }
                 part_of[e as usize] = Some(key);
             }
         }
+        Ok((part_of, names))
     }
-    let mut key_of_name: BTreeMap<String, usize> = names
-        .iter()
-        .enumerate()
-        .map(|(k, n)| (n.clone(), k))
-        .collect();
-    let mut hex_part = Vec::with_capacity(raw.hexes.len());
-    for (e, p) in part_of.iter().enumerate() {
-        let k = match p {
-            Some(k) => *k,
-            None => {
-                let n = hex_elset[e].clone().unwrap_or_else(|| "body".to_string());
-                *key_of_name.entry(n.clone()).or_insert_with(|| {
-                    names.push(n);
-                    names.len() - 1
-                })
-            }
+
+    /// The mesh's parts: each hexahedron's section part, else the `elset=` of its `*Element`,
+    /// else `body`.
+    fn assign_parts(&mut self, part_of: &[Option<usize>], mut names: Vec<String>) {
+        let mut key_of_name: BTreeMap<String, usize> = names
+            .iter()
+            .enumerate()
+            .map(|(k, n)| (n.clone(), k))
+            .collect();
+        let mut hex_part = Vec::with_capacity(self.raw.hexes.len());
+        for (e, p) in part_of.iter().enumerate() {
+            let k = match p {
+                Some(k) => *k,
+                None => {
+                    let n = self.hex_elset[e]
+                        .clone()
+                        .unwrap_or_else(|| "body".to_string());
+                    *key_of_name.entry(n.clone()).or_insert_with(|| {
+                        names.push(n);
+                        names.len() - 1
+                    })
+                }
+            };
+            hex_part.push(k as i64);
+        }
+        self.raw.part_names = names
+            .into_iter()
+            .enumerate()
+            .map(|(k, n)| (k as i64, n))
+            .collect();
+        self.raw.hex_part = Some(hex_part);
+    }
+}
+
+/// The members of a `generate` set: one range (first, last, increment 1 unless given) per
+/// data line; an empty or backward range is an error.
+fn generated_members(data: &[DataLine]) -> Result<Members, String> {
+    let mut members = Members::default();
+    for d in data {
+        let a = d.label(0, "first label")?;
+        let b = d.label(1, "last label")?;
+        let s = if d.fields.len() > 2 {
+            d.label(2, "increment")?
+        } else {
+            1
         };
-        hex_part.push(k as i64);
+        if s <= 0 || b < a {
+            return Err(format!(
+                "{}: generate `{a}, {b}, {s}` is empty or runs backwards",
+                at(d.line)
+            ));
+        }
+        members.ranges.insert((a, b, s));
     }
-    raw.part_names = names
-        .into_iter()
-        .enumerate()
-        .map(|(k, n)| (k as i64, n))
-        .collect();
-    raw.hex_part = Some(hex_part);
-    Ok(raw)
+    Ok(members)
 }
