@@ -92,8 +92,7 @@ pub use run_files::{read_done, read_run, run_dir, write_done, DoneMarker, RunSam
 pub use shard::{in_shard, parse_shard, recorded_shard, resolve_shard, shard_in};
 pub use spec::{
     CampaignSpec, HandSpec, IndentationSpec, LocationEntry, LocationsSpec, NamedPoint, OneOrMany,
-    PhantomSpec, RasterSpec, SolverSpec, CAMPAIGN_FAT_THICKNESS, CAMPAIGN_VOXEL,
-    DEFAULT_MAX_SAMPLES, MAX_RUNS,
+    RasterSpec, SolverSpec, CAMPAIGN_FAT_THICKNESS, CAMPAIGN_VOXEL, DEFAULT_MAX_SAMPLES, MAX_RUNS,
 };
 
 /// Name of the marker file of a finished run.
@@ -278,6 +277,13 @@ mod tests {
         assert!(e.to_string().contains("voxels"), "{e}");
         let spec: CampaignSpec = toml::from_str("[locations]\ntrain = [\"A\"]\n").unwrap();
         assert!(spec.resolve().unwrap_err().contains("twice"));
+        // a scene's [mesh.phantom] keys that a campaign's runs leave at their defaults
+        let spec: CampaignSpec = toml::from_str("[phantom]\ncoarsen = 2\n").unwrap();
+        let e = spec.resolve().unwrap_err();
+        assert!(
+            e.contains("phantom.coarsen") && e.contains("not a campaign key"),
+            "{e}"
+        );
         let spec: CampaignSpec = toml::from_str("[locations]\ntrain = [\"Q9\"]\n").unwrap();
         assert!(spec.resolve().unwrap_err().contains("unknown location"));
         let spec: CampaignSpec =

@@ -5,7 +5,7 @@ use crate::plan::{Campaign, CampaignLocation, PlannedRun, Split};
 use material::quantity::{Length, Number, Time, Velocity};
 use phantom::PAPER_VOXEL;
 use scene::palpation::{ElementChoice, PalpationSetup, Place, TumourSetup};
-use scene::phantom_spec::TumourScene;
+use scene::phantom_spec::PhantomScene;
 use serde::{Deserialize, Deserializer};
 use std::path::Path;
 
@@ -35,7 +35,7 @@ pub struct CampaignSpec {
     pub title: Option<String>,
     /// The phantom.
     #[serde(default)]
-    pub phantom: PhantomSpec,
+    pub phantom: PhantomScene,
     /// Where to press.
     #[serde(default)]
     pub locations: LocationsSpec,
@@ -48,23 +48,6 @@ pub struct CampaignSpec {
     /// Element formulation and time step.
     #[serde(default)]
     pub solver: SolverSpec,
-}
-
-/// `[phantom]`.
-#[derive(Clone, Debug, Default, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct PhantomSpec {
-    /// `reduced` (default) or `full`.
-    pub variant: Option<String>,
-    /// Voxel edge (default [`CAMPAIGN_VOXEL`], 3 mm).
-    pub voxel: Option<Length>,
-    /// Subcutaneous fat thickness (default [`CAMPAIGN_FAT_THICKNESS`], 25 mm).
-    pub fat_thickness: Option<Length>,
-    /// Respiratory phase 0..1 (default 0).
-    pub respiratory_phase: Option<Number>,
-    /// Liver tumours.
-    #[serde(default)]
-    pub tumours: Vec<TumourScene>,
 }
 
 /// A location entry: a name, a point, or a named point.
@@ -355,6 +338,18 @@ impl CampaignSpec {
     /// `[phantom]` and `[hand]` into the palpation settings.
     fn apply_phantom_and_hand(&self, base: &mut PalpationSetup) -> Result<(), String> {
         let p = &self.phantom;
+        // a scene's [mesh.phantom] table, less what every run of a campaign shares by default
+        for (given, key) in [
+            (p.coarsen.is_some(), "coarsen"),
+            (p.roi_radius.is_some(), "roi_radius"),
+            (p.roi_count.is_some(), "roi_count"),
+        ] {
+            if given {
+                return Err(format!(
+                    "phantom.{key}: not a campaign key (a campaign's runs mesh the phantom and pick its ROI with the defaults)"
+                ));
+            }
+        }
         if let Some(v) = &p.variant {
             v.parse::<phantom::Variant>()?;
             base.variant = v.clone();
