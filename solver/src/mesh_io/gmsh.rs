@@ -23,20 +23,14 @@ use mshio::ElementType;
 use std::collections::BTreeMap;
 use std::path::Path;
 
+/// A file as mshio reads it: node tags `u64`, entity tags `i32`, coordinates `f64`.
+type Msh = mshio::MshFile<u64, i32, f64>;
+
 /// Read a `.msh` file.
 pub fn read(path: &Path) -> Result<RawMesh, String> {
     let p = path.display();
     let bytes = std::fs::read(path).map_err(|e| format!("{p}: cannot read: {e}"))?;
-    let version = format_version(&bytes)
-        .ok_or_else(|| format!("{p}: not a Gmsh file (no `$MeshFormat` section)"))?;
-    if version != "4.1" {
-        return Err(format!(
-            "{p}: Gmsh format {version}; palpa reads format 4.1 (Gmsh's default; in Gmsh set \
-             `Mesh.MshFileVersion = 4.1` or use File > Export > Version 4 ASCII)"
-        ));
-    }
-    let format = mesh_format(&bytes).map_err(|e| format!("{p}: $MeshFormat: {e}"))?;
-    check_section_counts(&bytes, &format).map_err(|e| format!("{p}: {e}"))?;
+    check_header(path, &bytes)?;
     let msh = mshio::parse_msh_bytes(&bytes).map_err(|e| {
         let text = e.to_string();
         let short: Vec<&str> = text
@@ -47,16 +41,46 @@ pub fn read(path: &Path) -> Result<RawMesh, String> {
         format!("{p}: cannot parse the Gmsh file: {}", short.join(" "))
     })?;
     let names = physical_names(&bytes).map_err(|e| format!("{p}: $PhysicalNames: {e}"))?;
-    let physical = |dim: i32, tag: i32| -> String {
-        names
-            .get(&(dim, tag))
-            .cloned()
-            .unwrap_or_else(|| match dim {
-                3 => format!("physical_{tag}"),
-                _ => format!("physical_{dim}_{tag}"),
-            })
+    let groups = entity_groups(path, &msh)?;
+    let mut raw = RawMesh::default();
+    let index = read_nodes(path, &msh, &mut raw)?;
+    let Some(elements) = &msh.data.elements else {
+        return Ok(raw);
     };
-    // Physical tags of each geometric entity, by (dimension, tag).
+    let blocks = Blocks {
+        path,
+        names,
+        groups,
+        index,
+    };
+    let mut part = Vec::new();
+    for b in &elements.element_blocks {
+        blocks.read(b, &mut raw, &mut part)?;
+    }
+    raw.hex_part = Some(part);
+    Ok(raw)
+}
+
+/// What is checked before mshio sees the file: a `$MeshFormat` section of version 4.1 with an
+/// encoding mshio reads, and `$Nodes` and `$Elements` headers that do not state 0 entries.
+fn check_header(path: &Path, bytes: &[u8]) -> Result<(), String> {
+    let p = path.display();
+    let version = format_version(bytes)
+        .ok_or_else(|| format!("{p}: not a Gmsh file (no `$MeshFormat` section)"))?;
+    if version != "4.1" {
+        return Err(format!(
+            "{p}: Gmsh format {version}; palpa reads format 4.1 (Gmsh's default; in Gmsh set \
+             `Mesh.MshFileVersion = 4.1` or use File > Export > Version 4 ASCII)"
+        ));
+    }
+    let format = mesh_format(bytes).map_err(|e| format!("{p}: $MeshFormat: {e}"))?;
+    check_section_counts(bytes, &format).map_err(|e| format!("{p}: {e}"))
+}
+
+/// `$Entities`: the physical tags of each geometric entity, by (dimension, tag); a tag whose
+/// absolute value does not fit is an error.
+fn entity_groups(path: &Path, msh: &Msh) -> Result<BTreeMap<(i32, i32), Vec<i32>>, String> {
+    let p = path.display();
     let mut groups: BTreeMap<(i32, i32), Vec<i32>> = BTreeMap::new();
     if let Some(ent) = &msh.data.entities {
         let points = ent.points.iter().map(|e| (0, e.tag, &e.physical_tags));
@@ -78,38 +102,18 @@ pub fn read(path: &Path) -> Result<RawMesh, String> {
             groups.insert((dim as i32, tag), tags);
         }
     }
-    let mut raw = RawMesh::default();
+    Ok(groups)
+}
+
+/// `$Nodes`: the nodes and their tags into `raw`; returns each tag's node index. A tag given
+/// twice is an error.
+fn read_nodes(path: &Path, msh: &Msh, raw: &mut RawMesh) -> Result<BTreeMap<u64, u32>, String> {
+    let p = path.display();
     let mut index: BTreeMap<u64, u32> = BTreeMap::new();
     if let Some(nodes) = &msh.data.nodes {
         let mut next_tag = nodes.min_node_tag;
         for (k, b) in nodes.node_blocks.iter().enumerate() {
-            let tags: Vec<u64> = match &b.node_tags {
-                Some(map) => {
-                    // mshio maps tag -> index: a tag given twice in the block keeps one index
-                    if map.len() != b.nodes.len() {
-                        return Err(format!(
-                            "{p}: $Nodes: node block {} gives a node tag twice",
-                            k + 1
-                        ));
-                    }
-                    let mut t = vec![0u64; b.nodes.len()];
-                    for (&tag, &i) in map {
-                        t[i] = tag;
-                    }
-                    t
-                }
-                None => {
-                    let end = next_tag.checked_add(b.nodes.len() as u64).ok_or_else(|| {
-                        format!(
-                            "{p}: $Nodes: node tags from {} run past 2^64",
-                            nodes.min_node_tag
-                        )
-                    })?;
-                    let t = (next_tag..end).collect();
-                    next_tag = end;
-                    t
-                }
-            };
+            let tags = block_tags(path, b, k, nodes.min_node_tag, &mut next_tag)?;
             for (n, tag) in b.nodes.iter().zip(tags) {
                 if index.insert(tag, raw.nodes.len() as u32).is_some() {
                     return Err(format!("{p}: node {tag} is given twice"));
@@ -119,52 +123,100 @@ pub fn read(path: &Path) -> Result<RawMesh, String> {
             }
         }
     }
-    let Some(elements) = &msh.data.elements else {
-        return Ok(raw);
-    };
-    let mut part = Vec::new();
-    for b in &elements.element_blocks {
-        let (dim, etag) = (b.entity_dim, b.entity_tag);
-        let phys = groups.get(&(dim, etag)).cloned().unwrap_or_default();
-        let node = |e: &mshio::Element<u64>, k: usize| -> Result<u32, String> {
-            index.get(&e.nodes[k]).copied().ok_or_else(|| {
-                format!(
-                    "{p}: element {} refers to node {}, which the file does not define",
-                    e.element_tag, e.nodes[k]
-                )
+    Ok(index)
+}
+
+/// The node tags of node block `k` (0-based): the block's own, or contiguous from `next_tag`
+/// (which moves past them), counted from `min_tag` in the message when they overflow.
+fn block_tags(
+    path: &Path,
+    b: &mshio::NodeBlock<u64, i32, f64>,
+    k: usize,
+    min_tag: u64,
+    next_tag: &mut u64,
+) -> Result<Vec<u64>, String> {
+    let p = path.display();
+    Ok(match &b.node_tags {
+        Some(map) => {
+            // mshio maps tag -> index: a tag given twice in the block keeps one index
+            if map.len() != b.nodes.len() {
+                return Err(format!(
+                    "{p}: $Nodes: node block {} gives a node tag twice",
+                    k + 1
+                ));
+            }
+            let mut t = vec![0u64; b.nodes.len()];
+            for (&tag, &i) in map {
+                t[i] = tag;
+            }
+            t
+        }
+        None => {
+            let end = next_tag
+                .checked_add(b.nodes.len() as u64)
+                .ok_or_else(|| format!("{p}: $Nodes: node tags from {min_tag} run past 2^64"))?;
+            let t = (*next_tag..end).collect();
+            *next_tag = end;
+            t
+        }
+    })
+}
+
+/// What the element blocks are read against: the file (for messages), the physical names,
+/// the physical tags of each geometric entity, and the node index of each node tag.
+struct Blocks<'a> {
+    path: &'a Path,
+    names: BTreeMap<(i32, i32), String>,
+    groups: BTreeMap<(i32, i32), Vec<i32>>,
+    index: BTreeMap<u64, u32>,
+}
+
+impl Blocks<'_> {
+    /// The name of physical group `tag` of dimension `dim`: from `$PhysicalNames`, else
+    /// `physical_<tag>` (volumes) or `physical_<dim>_<tag>`.
+    fn physical(&self, dim: i32, tag: i32) -> String {
+        self.names
+            .get(&(dim, tag))
+            .cloned()
+            .unwrap_or_else(|| match dim {
+                3 => format!("physical_{tag}"),
+                _ => format!("physical_{dim}_{tag}"),
             })
-        };
+    }
+
+    /// The index of node `k` of element `e`; an error if the file does not define it.
+    fn node(&self, e: &mshio::Element<u64>, k: usize) -> Result<u32, String> {
+        self.index.get(&e.nodes[k]).copied().ok_or_else(|| {
+            format!(
+                "{}: element {} refers to node {}, which the file does not define",
+                self.path.display(),
+                e.element_tag,
+                e.nodes[k]
+            )
+        })
+    }
+
+    /// One element block: hexahedra of a volume (with their part keys into `part`), other
+    /// volume cells counted, lower-dimensional cells counted and their nodes put in the node
+    /// sets of their entity's physical groups.
+    fn read(
+        &self,
+        b: &mshio::ElementBlock<u64, i32>,
+        raw: &mut RawMesh,
+        part: &mut Vec<i64>,
+    ) -> Result<(), String> {
+        let (dim, etag) = (b.entity_dim, b.entity_tag);
+        let phys = self.groups.get(&(dim, etag)).cloned().unwrap_or_default();
         if dim == 3 {
             if b.element_type != ElementType::Hex8 {
                 *raw.other_volume.entry(kind(b.element_type)).or_default() += b.elements.len();
-                continue;
+                return Ok(());
             }
-            let key = match phys.as_slice() {
-                [] => {
-                    raw.part_names
-                        .insert(-(etag as i64), format!("volume_{etag}"));
-                    -(etag as i64)
-                }
-                [t] => {
-                    raw.part_names.insert(*t as i64, physical(3, *t));
-                    *t as i64
-                }
-                many => {
-                    return Err(format!(
-                        "{p}: geometric volume {etag} belongs to {} physical volumes ({}); \
-                         palpa needs one part per hexahedron",
-                        many.len(),
-                        many.iter()
-                            .map(|&t| physical(3, t))
-                            .collect::<Vec<_>>()
-                            .join(", ")
-                    ))
-                }
-            };
+            let key = self.part_key(etag, &phys, raw)?;
             for e in &b.elements {
                 let mut h = [0u32; 8];
                 for (k, slot) in h.iter_mut().enumerate() {
-                    *slot = node(e, k)?;
+                    *slot = self.node(e, k)?;
                 }
                 raw.hexes.push(h);
                 raw.hex_labels.push(format!("element {}", e.element_tag));
@@ -173,17 +225,45 @@ pub fn read(path: &Path) -> Result<RawMesh, String> {
         } else {
             *raw.other_lower.entry(kind(b.element_type)).or_default() += b.elements.len();
             for &t in &phys {
-                let set = raw.node_sets.entry(physical(dim, t)).or_default();
+                let set = raw.node_sets.entry(self.physical(dim, t)).or_default();
                 for e in &b.elements {
                     for k in 0..e.nodes.len() {
-                        set.push(node(e, k)?);
+                        set.push(self.node(e, k)?);
                     }
                 }
             }
         }
+        Ok(())
     }
-    raw.hex_part = Some(part);
-    Ok(raw)
+
+    /// The part key of the hexahedra of geometric volume `etag` in the physical volumes
+    /// `phys`, its name put in `raw`: the physical volume, or `-etag` (`volume_<etag>`) for a
+    /// volume in none; an error for a volume in several.
+    fn part_key(&self, etag: i32, phys: &[i32], raw: &mut RawMesh) -> Result<i64, String> {
+        Ok(match phys {
+            [] => {
+                raw.part_names
+                    .insert(-(etag as i64), format!("volume_{etag}"));
+                -(etag as i64)
+            }
+            [t] => {
+                raw.part_names.insert(*t as i64, self.physical(3, *t));
+                *t as i64
+            }
+            many => {
+                return Err(format!(
+                    "{}: geometric volume {etag} belongs to {} physical volumes ({}); \
+                     palpa needs one part per hexahedron",
+                    self.path.display(),
+                    many.len(),
+                    many.iter()
+                        .map(|&t| self.physical(3, t))
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                ))
+            }
+        })
+    }
 }
 
 /// Gmsh element kinds in the words of the messages.
