@@ -106,3 +106,20 @@ fn numpy_reads_the_npz_in_one_line() {
     );
     assert_eq!(text.trim(), expected);
 }
+
+/// The same dataset written twice, seconds apart, gives the same bytes: the npz holds no time
+/// stamp (so a campaign's dataset is identical from run to run and across shards).
+#[test]
+fn npz_bytes_do_not_depend_on_when_it_was_written() {
+    let a = tempfile::tempdir().unwrap();
+    let b = tempfile::tempdir().unwrap();
+    let d = make_synthetic_dataset(5);
+    d.write(a.path()).unwrap();
+    std::thread::sleep(std::time::Duration::from_millis(2100));
+    d.write(b.path()).unwrap();
+    for f in ["dataset.npz", "manifest.json"] {
+        let x = std::fs::read(a.path().join(f)).unwrap();
+        let y = std::fs::read(b.path().join(f)).unwrap();
+        assert!(x == y, "{f} differs between two writes");
+    }
+}
