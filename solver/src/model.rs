@@ -827,8 +827,8 @@ impl Builder<'_> {
         pm.physical += rho * geo.volume;
         pm.added += rho * geo.volume * (s - 1.0);
         pm.elements += 1;
-        for a in 0..8 {
-            self.mass[conn[a] as usize] += rho * s * geo.lumped_volume[a];
+        for (&n, &v) in conn.iter().zip(&geo.lumped_volume) {
+            self.mass[n as usize] += rho * s * v;
         }
         Ok(())
     }
