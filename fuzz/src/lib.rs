@@ -240,7 +240,8 @@ pub fn material(data: &[u8]) {
 }
 
 /// A campaign file: parsed, resolved into its runs, the phantom parameters checked, and every
-/// run's generated scene parsed back (the phantom is not built; `--dry-run` builds it).
+/// run's generated scene file parsed back and compared with the scene built in memory (the
+/// phantom is not built; `--dry-run` builds it).
 pub fn campaign(data: &[u8]) {
     let Some(src) = text(data, MAX_TEXT) else {
         return;
@@ -254,12 +255,20 @@ pub fn campaign(data: &[u8]) {
     verbose("phantom", &c.phantom_params());
     for r in c.runs.iter().take(64) {
         let _ = c.samples_per_run(r);
-        let scene = c.setup(r).scene_toml();
-        if let Err(e) = toml::from_str::<scene::SceneSpec>(&scene) {
-            panic!(
+        let setup = c.setup(r);
+        let scene = setup.scene_toml();
+        match toml::from_str::<scene::SceneSpec>(&scene) {
+            Err(e) => panic!(
                 "run {}: the generated scene does not parse: {e}\n{scene}",
                 r.label
-            );
+            ),
+            // the file is the scene that runs
+            Ok(parsed) => assert_eq!(
+                format!("{parsed:?}"),
+                format!("{:?}", setup.scene_spec()),
+                "run {}: the scene file differs from the scene built in memory\n{scene}",
+                r.label
+            ),
         }
     }
 }

@@ -289,6 +289,32 @@ impl PalpationSetup {
             Some(StepTarget::Initial(k)) => pos(k, "mass-scaling multiple of the initial step")?,
             None => {}
         }
+        if !(self.mass_scaling_limit >= 0.0 && self.mass_scaling_limit.is_finite()) {
+            return Err(format!(
+                "mass-scaling limit must be a finite fraction of the mass, 0 or more, got {}",
+                self.mass_scaling_limit
+            ));
+        }
+        let finite = |v: f64, what: &str| {
+            if v.is_finite() {
+                Ok(())
+            } else {
+                Err(format!("{what} must be finite, got {v}"))
+            }
+        };
+        finite(self.fat_thickness, "fat thickness")?;
+        finite(self.respiratory_phase, "respiratory phase")?;
+        for t in &self.tumours {
+            for c in t.center {
+                finite(c, "tumour centre")?;
+            }
+            pos(t.radius, "tumour radius")?;
+            pos(t.stiffness, "tumour stiffness")?;
+        }
+        if let Place::At(x, y) = self.place {
+            finite(x, "x of the place")?;
+            finite(y, "y of the place")?;
+        }
         Ok(())
     }
 

@@ -23,6 +23,36 @@ use std::collections::BTreeMap;
 use std::fmt::Write;
 use std::path::Path;
 
+/// `s` as a TOML basic string: quotes, backslashes and control characters escaped (the same
+/// text as Rust's `{:?}` for a printable string).
+fn toml_str(s: &str) -> String {
+    let mut out = String::with_capacity(s.len() + 2);
+    out.push('"');
+    for c in s.chars() {
+        match c {
+            '"' => out.push_str("\\\""),
+            '\\' => out.push_str("\\\\"),
+            '\n' => out.push_str("\\n"),
+            '\t' => out.push_str("\\t"),
+            '\r' => out.push_str("\\r"),
+            c if c.is_control() => out.push_str(&format!("\\u{:04X}", c as u32)),
+            c => out.push(c),
+        }
+    }
+    out.push('"');
+    out
+}
+
+/// A plain number as TOML reads it back: as Rust prints it, unless that would be an integer
+/// too large for TOML (then in exponent form). The value must be finite.
+fn toml_num(x: f64) -> String {
+    if x.abs() < 1e15 {
+        format!("{x}")
+    } else {
+        format!("{x:?}")
+    }
+}
+
 /// The phantom parts and their laws (see the palpation module doc); tumours come after them.
 pub(crate) const PART_MATERIALS: [(&str, &str); 5] = [
     ("flesh", "paper:flesh"),
@@ -243,10 +273,10 @@ impl PalpationSetup {
         );
         let _ = writeln!(
             s,
-            "[run]\ntitle = {:?}\nend_time = \"{} s\"\ndt_factor = {}\nprecision = {:?}\n",
-            self.title,
+            "[run]\ntitle = {}\nend_time = \"{} s\"\ndt_factor = {}\nprecision = {:?}\n",
+            toml_str(&self.title),
             self.duration,
-            self.dt_factor,
+            toml_num(self.dt_factor),
             self.precision.label()
         );
         self.write_mesh(&mut s);
@@ -259,11 +289,11 @@ impl PalpationSetup {
             let _ = writeln!(
                 s,
                 "[mass_scaling]\ntarget_dt = \"{t}\"\nmax_added = {}\n",
-                self.mass_scaling_limit
+                toml_num(self.mass_scaling_limit)
             );
         }
         let place = match &self.place {
-            Place::Named(n) => format!("location = {n:?}"),
+            Place::Named(n) => format!("location = {}", toml_str(n)),
             Place::At(x, y) => format!("at = [\"{x} m\", \"{y} m\"]"),
         };
         let _ = writeln!(
@@ -286,9 +316,12 @@ impl PalpationSetup {
     fn write_mesh(&self, s: &mut String) {
         let _ = writeln!(
             s,
-            "[mesh]\ngenerator = \"phantom\"\n\n[mesh.phantom]\nvariant = {:?}\nvoxel = \"{} m\"\n\
+            "[mesh]\ngenerator = \"phantom\"\n\n[mesh.phantom]\nvariant = {}\nvoxel = \"{} m\"\n\
              fat_thickness = \"{} m\"\nrespiratory_phase = {}",
-            self.variant, self.voxel, self.fat_thickness, self.respiratory_phase
+            toml_str(&self.variant),
+            self.voxel,
+            self.fat_thickness,
+            toml_num(self.respiratory_phase)
         );
         if !self.tumours.is_empty() {
             s.push_str("tumours = [\n");
@@ -296,7 +329,11 @@ impl PalpationSetup {
                 let _ = writeln!(
                     s,
                     "  {{ center = [\"{} m\", \"{} m\", \"{} m\"], radius = \"{} m\", stiffness = {} }},",
-                    t.center[0], t.center[1], t.center[2], t.radius, t.stiffness
+                    t.center[0],
+                    t.center[1],
+                    t.center[2],
+                    t.radius,
+                    toml_num(t.stiffness)
                 );
             }
             s.push_str("]\n");
@@ -423,7 +460,7 @@ mod tests {
     fn the_scene_file_parses_to_the_scene_built_in_memory() {
         let mut setups = vec![PalpationSetup::default()];
         let mut s = PalpationSetup {
-            title: "P07 \"quoted\"".into(),
+            title: "P07 \"quoted\" \\ tab\t bell\u{7} nul\u{0} é".into(),
             place: Place::At(-0.0725, 0.1815),
             tumours: vec![
                 TumourSetup {
@@ -434,10 +471,11 @@ mod tests {
                 TumourSetup {
                     center: [-0.05, 0.2, 0.14],
                     radius: 0.008,
-                    stiffness: 3.3,
+                    stiffness: 2e16,
                 },
             ],
             mass_scaling: Some(StepTarget::Step(4e-6)),
+            mass_scaling_limit: 3e19,
             max_bulk_ratio: Some(5000.0),
             precision: Precision::F32,
             vtk: false,
@@ -472,6 +510,33 @@ mod tests {
                 format!("{:#?}", s.scene_spec()),
                 "{text}"
             );
+        }
+    }
+
+    /// Values the scene file could not carry are refused before it is written.
+    #[test]
+    fn non_finite_values_are_refused() {
+        let bad = [
+            PalpationSetup {
+                mass_scaling_limit: f64::NAN,
+                ..Default::default()
+            },
+            PalpationSetup {
+                tumours: vec![TumourSetup {
+                    center: [0.0, 0.1, f64::INFINITY],
+                    radius: 0.01,
+                    stiffness: 2.0,
+                }],
+                ..Default::default()
+            },
+            PalpationSetup {
+                respiratory_phase: f64::NAN,
+                ..Default::default()
+            },
+        ];
+        for s in bad {
+            let e = s.validate().unwrap_err();
+            assert!(e.contains("finite"), "{e}");
         }
     }
 }
