@@ -101,20 +101,21 @@ pub fn first_difference(there: &Value, here: &Value, path: &str) -> Option<Strin
 
 /// Make `out` the directory of this campaign (`plan`, `shard`): create it, refuse one that holds
 /// another campaign (naming where the plans part) or finished runs without `resume`, and write
-/// `campaign.json`. Returns the solver version of the finished runs when it is not this one.
+/// `campaign.json`. `note` hears the solver version of the finished runs when it is not this
+/// one, before any refusal.
 pub fn prepare_dir(
     out: &Path,
     plan: &CampaignPlan,
     shard: Option<(usize, usize)>,
     n_done: usize,
     resume: bool,
-) -> Result<Option<Value>, String> {
+    note: &mut dyn FnMut(&Value),
+) -> Result<(), String> {
     std::fs::create_dir_all(out)
         .map_err(|e| format!("{}: cannot create the output directory: {e}", out.display()))?;
     let cfile = out.join(CAMPAIGN_FILE);
     let plan = plan.to_value();
     let desc = campaign_file(&plan, shard);
-    let mut other_version = None;
     if cfile.exists() {
         let old = read_json(&cfile)?;
         if let Some(d) = first_difference(old.get("plan").unwrap_or(&Value::Null), &plan, "plan") {
@@ -125,7 +126,7 @@ pub fn prepare_dir(
             ));
         }
         if old.get("solver_version") != desc.get("solver_version") {
-            other_version = Some(old.get("solver_version").cloned().unwrap_or(Value::Null));
+            note(old.get("solver_version").unwrap_or(&Value::Null));
         }
     }
     if n_done > 0 && !resume {
@@ -134,8 +135,7 @@ pub fn prepare_dir(
             out.display()
         ));
     }
-    write_json(&cfile, &desc)?;
-    Ok(other_version)
+    write_json(&cfile, &desc)
 }
 
 #[cfg(test)]

@@ -32,7 +32,7 @@ pub enum RunEvent<'a> {
         /// Its simulated time (s).
         time: f64,
     },
-    /// Job `slot`'s run finished: the `count`-th run of this invocation.
+    /// Job `slot`'s run finished.
     Finished {
         /// The job.
         slot: usize,
@@ -40,10 +40,15 @@ pub enum RunEvent<'a> {
         run: &'a PlannedRun,
         /// Its marker.
         marker: &'a DoneMarker,
-        /// How many runs have finished in this invocation, this one included.
-        count: usize,
     },
-    /// Job `slot`'s run failed (not reported for a run ended by the stop flag).
+    /// Job `slot`'s run was ended by the stop flag (it stays unfinished).
+    Stopped {
+        /// The job.
+        slot: usize,
+        /// The run.
+        run: &'a PlannedRun,
+    },
+    /// Job `slot`'s run failed.
     Failed {
         /// The job.
         slot: usize,
@@ -67,7 +72,8 @@ pub struct Report {
 }
 
 /// Run `todo`, `jobs` at a time with `threads` each, reusing `phantom`, until done or `stop`.
-/// `on` sees every run start, progress, finish or fail (the events of one job in order).
+/// `on` sees every run start, progress and end (finished, stopped or failed; the events of
+/// one job in order, those of different jobs interleaved).
 #[allow(clippy::too_many_arguments)]
 pub fn execute(
     c: &Campaign,
@@ -104,23 +110,21 @@ pub fn execute(
             *run_seconds.lock().unwrap() += t0.elapsed().as_secs_f64();
             match res {
                 Ok(marker) => {
-                    let count = finished.fetch_add(1, Ordering::SeqCst) + 1;
+                    finished.fetch_add(1, Ordering::SeqCst);
                     on(RunEvent::Finished {
                         slot,
                         run,
                         marker: &marker,
-                        count,
                     });
                 }
+                Err(_) if stop.load(Ordering::SeqCst) => on(RunEvent::Stopped { slot, run }),
                 Err(error) => {
-                    if !stop.load(Ordering::SeqCst) {
-                        on(RunEvent::Failed {
-                            slot,
-                            run,
-                            error: &error,
-                        });
-                        failed.lock().unwrap().push((run.label.clone(), error));
-                    }
+                    on(RunEvent::Failed {
+                        slot,
+                        run,
+                        error: &error,
+                    });
+                    failed.lock().unwrap().push((run.label.clone(), error));
                 }
             }
         }

@@ -6,6 +6,7 @@ use serde::{Deserialize, Serialize};
 
 /// The phantom parameters a campaign's plan and its dataset's manifest record.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct PhantomRecord {
     /// `reduced` or `full`.
     pub variant: String,
@@ -39,6 +40,7 @@ fn one() -> usize {
 
 /// One tumour of a [`PhantomRecord`].
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct TumourRecord {
     /// Centre (m).
     pub center_m: [f64; 3],
@@ -50,6 +52,7 @@ pub struct TumourRecord {
 
 /// The raster of a [`PhantomRecord`].
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct GridRecord {
     /// Centre (x, y; m).
     pub center_m: [f64; 2],
@@ -57,6 +60,15 @@ pub struct GridRecord {
     pub spacing_m: [f64; 2],
     /// Points along x and y.
     pub n: [usize; 2],
+}
+
+/// A deserialisation error with the key it happened at (`` `grid.n`: invalid length 1 ``), or
+/// without one at the top level (`missing field `variant``).
+pub(crate) fn at_key(e: &serde_path_to_error::Error<serde_json::Error>) -> String {
+    match e.path().to_string().as_str() {
+        "." | "" => e.inner().to_string(),
+        p => format!("`{p}`: {}", e.inner()),
+    }
 }
 
 impl PhantomRecord {
@@ -92,7 +104,7 @@ impl PhantomRecord {
     /// Read a record from JSON (a plan's `phantom`, a manifest's `phantom.parameters`).
     pub fn from_value(v: &serde_json::Value) -> Result<PhantomRecord, String> {
         serde_path_to_error::deserialize(v)
-            .map_err(|e| format!("phantom parameters: `{}`: {}", e.path(), e.inner()))
+            .map_err(|e| format!("phantom parameters: {}", at_key(&e)))
     }
 
     /// The phantom parameters back. Meshing options other than `coarsen` take their defaults,

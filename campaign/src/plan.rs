@@ -173,6 +173,7 @@ impl Campaign {
 
 /// The plan of a campaign: settings, phantom, ROI, resolved locations and runs (SI).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct CampaignPlan {
     /// Title.
     pub title: String,
@@ -190,6 +191,7 @@ pub struct CampaignPlan {
 
 /// The palpation settings of a plan.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct PlanSettings {
     /// Sample interval (s).
     pub sample_interval_s: f64,
@@ -220,6 +222,7 @@ pub struct PlanSettings {
 
 /// The ROI of a plan.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct PlanRoi {
     /// Its centre (m).
     pub center_m: [f64; 3],
@@ -241,6 +244,7 @@ pub enum PlaceKind {
 
 /// One location of a plan.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct PlanLocation {
     /// Label.
     pub label: String,
@@ -258,6 +262,7 @@ pub struct PlanLocation {
 
 /// One run of a plan.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct PlanRun {
     /// Position in the campaign's order (0-based).
     pub index: usize,
@@ -281,8 +286,12 @@ impl CampaignPlan {
 
     /// Read a plan from JSON; an error names the missing or malformed key.
     pub fn from_value(v: &serde_json::Value) -> Result<CampaignPlan, String> {
-        serde_path_to_error::deserialize(v)
-            .map_err(|e| format!("campaign.json: the plan: `{}`: {}", e.path(), e.inner()))
+        serde_path_to_error::deserialize(v).map_err(|e| {
+            format!(
+                "campaign.json: the plan: {}",
+                crate::phantom_record::at_key(&e)
+            )
+        })
     }
 
     /// The run labelled `label`.

@@ -160,7 +160,7 @@ fn run_campaign(a: &CampaignArgs) -> Result<(), String> {
     }
 
     // campaign.json: a resumed campaign must be the same campaign.
-    if let Some(v) = campaign::prepare_dir(out, &plan, shard, n_done, a.resume)? {
+    campaign::prepare_dir(out, &plan, shard, n_done, a.resume, &mut |v| {
         if !a.quiet {
             println!(
                 "  note: the finished runs in {} were made by palpa {v}, this is {}",
@@ -168,7 +168,7 @@ fn run_campaign(a: &CampaignArgs) -> Result<(), String> {
                 env!("CARGO_PKG_VERSION")
             );
         }
-    }
+    })?;
     let view = super::view_geometry::from_phantom(
         &phantom,
         &phantom.mesh,
@@ -376,11 +376,11 @@ fn execute_with_progress(
                 slot,
                 run,
                 marker: m,
-                count,
             } => {
                 s.0[slot] = None;
                 s.1 += run.duration;
-                finished.fetch_max(count, Ordering::Relaxed);
+                // counted under the lock, so the lines come out in order
+                let count = finished.fetch_add(1, Ordering::Relaxed) + 1;
                 if !quiet {
                     say(format!(
                         "  done {:<16} ({count}/{n}): {} steps, {} samples, {:.1} s on {} thread(s)",
@@ -388,6 +388,7 @@ fn execute_with_progress(
                     ));
                 }
             }
+            RunEvent::Stopped { slot, .. } => s.0[slot] = None,
             RunEvent::Failed { slot, run, error } => {
                 s.0[slot] = None;
                 say(format!("  FAILED {}: {error}", run.label));
