@@ -103,7 +103,6 @@ pub const CAMPAIGN_FILE: &str = "campaign.json";
 pub const CAMPAIGN_FORMAT: &str = "palpa-campaign";
 
 #[cfg(test)]
-#[cfg(test)]
 mod tests {
     use super::*;
     use phantom::PhantomParams;

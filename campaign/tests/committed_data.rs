@@ -19,7 +19,7 @@ fn committed_plans_read_typed_and_write_back_to_the_same_bytes() {
     for dir in committed() {
         let file = std::fs::read_to_string(dir.join("campaign.json")).unwrap();
         let cd = read_campaign_dir(&dir).unwrap();
-        let plan = CampaignPlan::from_value(&cd.plan_value).unwrap();
+        let plan = cd.plan().unwrap();
         let back = serde_json::to_string_pretty(&campaign_file(&plan.to_value(), cd.shard))
             .unwrap()
             .replace(
@@ -55,7 +55,7 @@ fn a_plan_with_an_unknown_or_missing_key_is_an_error_naming_it() {
 #[test]
 fn committed_dataset_reassembles_to_the_same_bytes() {
     let dir = &committed()[0];
-    let plan = CampaignPlan::from_value(&read_campaign_dir(dir).unwrap().plan_value).unwrap();
+    let plan = read_campaign_dir(dir).unwrap().plan().unwrap();
     let labels: Vec<String> = plan.runs.iter().map(|r| r.label.clone()).collect();
     let ds = assemble(&plan, &labels, |l| run_dir(dir, l)).unwrap();
     let tmp = tempfile::tempdir().unwrap();

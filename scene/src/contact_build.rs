@@ -190,7 +190,7 @@ pub fn resolve_contact(
         }
     }
 
-    let (nodes, parts) = surface_selection(mesh, contact, &at)?;
+    let (nodes, parts) = surface_selection(mesh, contact, &loc)?;
     let d = ContactScene::default();
     let mut params = contact_params(Some(contact.unwrap_or(&d)), 0.0)
         .map_err(|m| at("[contact]", "contact", &m))?;
@@ -210,13 +210,14 @@ pub fn resolve_contact(
 }
 
 /// The contact surface's selection from `[contact]`: a node mask from `surface` (a node set)
-/// and a part mask from `parts`; `at(needle, key, msg)` places an error in the scene file.
+/// and a part mask from `parts`; `loc` places an error in the scene file.
 #[allow(clippy::type_complexity)]
 fn surface_selection(
     mesh: &Mesh,
     contact: Option<&ContactScene>,
-    at: &dyn Fn(&str, &str, &dyn std::fmt::Display) -> String,
+    loc: &Locate,
 ) -> Result<(Option<Vec<bool>>, Option<Vec<bool>>), String> {
+    let at = |needle: &str, key: &str, msg: &dyn std::fmt::Display| loc.err(key, Some(needle), msg);
     let c = contact;
     let nodes: Option<Vec<bool>> = match c.and_then(|c| c.surface.as_ref()) {
         None => None,
@@ -300,8 +301,8 @@ pub fn build_stage(
         design_dt,
         path,
     };
-    let gaps = backing.gaps(&mut specs, &hands, &origins, contact.indenters.len())?;
     let n_ind = contact.indenters.len();
+    let gaps = backing.gaps(&mut specs, &hands, &origins, n_ind)?;
     for (k, h) in hands.iter().enumerate() {
         let gap = gaps[k];
         if gap <= 0.0 {

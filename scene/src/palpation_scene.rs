@@ -54,7 +54,7 @@ fn toml_num(x: f64) -> String {
 }
 
 /// The phantom parts and their laws (see the palpation module doc); tumours come after them.
-pub(crate) const PART_MATERIALS: [(&str, &str); 5] = [
+const PART_MATERIALS: [(&str, &str); 5] = [
     ("flesh", "paper:flesh"),
     ("liver", "paper:liver"),
     ("ribs", "paper:ribs"),
@@ -63,7 +63,7 @@ pub(crate) const PART_MATERIALS: [(&str, &str); 5] = [
 ];
 
 /// The fields of a palpation's VTK frames.
-pub(crate) const FRAME_FIELDS: [&str; 4] = ["displacement", "part", "von_mises", "max_principal"];
+const FRAME_FIELDS: [&str; 4] = ["displacement", "part", "von_mises", "max_principal"];
 
 /// The liver's Ogden moduli mu_p (Pa), exponents and Prony moduli (Pa) with their times (ms).
 const LIVER_MU: [f64; 3] = [89.14, 9.965, -92.75];
@@ -72,7 +72,7 @@ const LIVER_PRONY: [f64; 3] = [6970.1, 58327.0, 35291.0];
 const LIVER_TAU_MS: [f64; 3] = [10.0, 100.0, 1000.0];
 
 /// The liver card with its moduli scaled by `s` (a tumour's stiffness factor).
-pub(crate) fn scaled_liver(s: f64) -> ([f64; 3], [f64; 3]) {
+fn scaled_liver(s: f64) -> ([f64; 3], [f64; 3]) {
     (LIVER_MU.map(|m| m * s), LIVER_PRONY.map(|m| m * s))
 }
 
@@ -100,7 +100,7 @@ fn scaled_liver_spec(s: f64) -> MaterialSpec {
 }
 
 /// Text of the liver card with its moduli scaled by `s`, for the scene file.
-pub(crate) fn scaled_liver_card(s: f64) -> String {
+fn scaled_liver_card(s: f64) -> String {
     let (mu, g) = scaled_liver(s);
     let a = LIVER_ALPHA;
     let t = LIVER_TAU_MS;
@@ -131,7 +131,7 @@ impl ElementChoice {
     }
 
     /// The `[[part]]` keys of the choice: formulation, hourglass form, coefficient and modulus.
-    pub(crate) fn part_keys(
+    fn part_keys(
         &self,
     ) -> (
         &'static str,
@@ -181,7 +181,7 @@ impl PalpationSetup {
 
     /// The element choice of part `part`: its own entry, the liver's for a tumour, else the
     /// common one.
-    pub(crate) fn element_of(&self, part: &str) -> ElementChoice {
+    fn element_of(&self, part: &str) -> ElementChoice {
         let tumour = phantom::is_tumour_part(part);
         *self
             .part_elements
@@ -404,7 +404,7 @@ impl PalpationSetup {
     }
 
     /// The cut planes and the direction each roller fixes.
-    pub(crate) fn rollers(&self) -> &'static [(&'static str, &'static str)] {
+    fn rollers(&self) -> &'static [(&'static str, &'static str)] {
         if self.variant == "full" {
             &[("cut_ymin", "y"), ("cut_ymax", "y")]
         } else {
@@ -444,7 +444,7 @@ impl PalpationSetup {
 }
 
 /// Finger length, tip to far end (m).
-pub(crate) const HAND_LENGTH: f64 = 0.06;
+const HAND_LENGTH: f64 = 0.06;
 
 #[cfg(test)]
 mod tests {

@@ -28,13 +28,6 @@ pub enum RunStatus {
     Failed(String),
 }
 
-impl RunStatus {
-    /// Whether the run reached its end (completed or converged).
-    pub fn finished(&self) -> bool {
-        matches!(self, RunStatus::Completed | RunStatus::Converged)
-    }
-}
-
 impl std::fmt::Display for RunStatus {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         match self {

@@ -1,6 +1,7 @@
 //! The contact stage of the time loop: the `contact` crate's penalty contact behind the solver's
 //! [`ForceStage`] interface. A scene builds it from its `[[indenter]]`, `[[hand]]` and `[contact]`
-//! tables (the `scene` crate's `contact_build`, which also documents the default penalty).
+//! tables (the `scene` crate's `contact_build`; its `contact_spec` documents the format and the
+//! default penalty).
 //!
 //! ## Surface
 //! The contact surface is the mesh boundary ([`crate::mesh::Mesh::boundary_faces`], outward

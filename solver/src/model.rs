@@ -643,6 +643,7 @@ impl Model {
             },
         })
     }
+
     /// Total physical mass (kg).
     pub fn physical_mass(&self) -> f64 {
         self.part_mass.iter().map(|p| p.physical).sum()

@@ -1038,8 +1038,6 @@ struct StepSums {
     w_damp_new: f64,
     /// Kinetic energy at t^n, of `v^n = (v^(n-1/2) + v^(n+1/2)) / 2`.
     kinetic: f64,
-    /// Kinetic energy of `v^(n+1/2)`.
-    kinetic_half: f64,
     /// `|f_ext - f_int - f_damp|^2` over the free degrees of freedom.
     residual2: f64,
     /// `|f_int|^2`.
@@ -1060,7 +1058,6 @@ impl StepSums {
         self.w_damp_old += o.w_damp_old;
         self.w_damp_new += o.w_damp_new;
         self.kinetic += o.kinetic;
-        self.kinetic_half += o.kinetic_half;
         self.residual2 += o.residual2;
         self.f_int2 += o.f_int2;
         self.u_f_int += o.u_f_int;
@@ -1137,7 +1134,6 @@ impl NodalUpdate<'_> {
         s.w_damp_new += fd * h_new;
         let vn = 0.5 * (v_old + v_new);
         s.kinetic += 0.5 * m * vn * vn;
-        s.kinetic_half += 0.5 * m * v_new * v_new;
         *v = v_new;
         *u += p.dt * v_new;
         r

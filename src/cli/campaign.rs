@@ -323,7 +323,6 @@ type Slots = (Vec<Option<(String, f64, f64)>>, f64);
 
 /// Run `todo` ([`campaign::execute`]) with one progress bar over the simulated time of all of
 /// them, and a line per finished or failed run.
-#[allow(clippy::too_many_arguments)]
 fn execute_with_progress(
     c: &Campaign,
     todo: &[&PlannedRun],
@@ -402,7 +401,7 @@ fn execute_with_progress(
 }
 
 fn print_dataset(ds: &Dataset, out: &Path, partial: bool) {
-    let train = ds.rows_with_split(surrogate::Split::Train).len();
+    let train = ds.rows_with_split(Split::Train).len();
     let (lo, hi) =
         ds.y.iter()
             .fold((f64::INFINITY, f64::NEG_INFINITY), |a, &v| {

@@ -213,7 +213,11 @@ impl Dataset {
                 ));
             }
         }
-        if let Some(i) = self.split.iter().position(|&s| s > 1) {
+        if let Some(i) = self
+            .split
+            .iter()
+            .position(|&s| crate::Split::from_code(s).is_none())
+        {
             return Err(Error::invalid(
                 "split",
                 format!(
