@@ -83,7 +83,7 @@ pub use execute::{execute, run_one, Report, RunEvent};
 pub use json_file::{read_json, write_json};
 pub use merge::{merge, MergeReport};
 
-pub use phantom_record::{GridRecord, PhantomRecord, TumourRecord};
+pub use phantom_record::{GridRecord, PhantomRecord};
 pub use plan::{
     Campaign, CampaignLocation, CampaignPlan, PlaceKind, PlanLocation, PlanRoi, PlanRun,
     PlanSettings, PlannedRun, Split,

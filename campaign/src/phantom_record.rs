@@ -25,7 +25,7 @@ pub struct PhantomRecord {
     pub coarsen: usize,
     /// Tumours.
     #[serde(default)]
-    pub tumours: Vec<TumourRecord>,
+    pub tumours: Vec<Tumour>,
     /// ROI radius (m).
     pub roi_radius_m: f64,
     /// Largest ROI element count, `None` for no limit.
@@ -36,18 +36,6 @@ pub struct PhantomRecord {
 
 fn one() -> usize {
     1
-}
-
-/// One tumour of a [`PhantomRecord`].
-#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
-#[serde(deny_unknown_fields)]
-pub struct TumourRecord {
-    /// Centre (m).
-    pub center_m: [f64; 3],
-    /// Radius (m).
-    pub radius_m: f64,
-    /// Stiffness relative to the liver.
-    pub stiffness_factor: f64,
 }
 
 /// The raster of a [`PhantomRecord`].
@@ -82,15 +70,7 @@ impl PhantomRecord {
             max_liver_shift_m: p.max_liver_shift,
             torso_m: [p.torso_width, p.torso_depth, p.torso_length],
             coarsen: p.mesh.coarsen,
-            tumours: p
-                .tumours
-                .iter()
-                .map(|t| TumourRecord {
-                    center_m: t.center,
-                    radius_m: t.radius,
-                    stiffness_factor: t.stiffness_factor,
-                })
-                .collect(),
+            tumours: p.tumours.clone(),
             roi_radius_m: p.roi.radius,
             roi_max_count: p.roi.max_count,
             grid: GridRecord {
@@ -121,15 +101,7 @@ impl PhantomRecord {
         };
         [p.torso_width, p.torso_depth, p.torso_length] = self.torso_m;
         p.mesh.coarsen = self.coarsen;
-        p.tumours = self
-            .tumours
-            .iter()
-            .map(|t| Tumour {
-                center: t.center_m,
-                radius: t.radius_m,
-                stiffness_factor: t.stiffness_factor,
-            })
-            .collect();
+        p.tumours = self.tumours.clone();
         p.roi.radius = self.roi_radius_m;
         p.roi.max_count = self.roi_max_count;
         p.grid = GridParams {

@@ -4,7 +4,7 @@
 use crate::plan::{Campaign, CampaignLocation, PlannedRun, Split};
 use material::quantity::{Length, Number, Time, Velocity};
 use phantom::PAPER_VOXEL;
-use scene::palpation::{ElementChoice, PalpationSetup, Place, TumourSetup};
+use scene::palpation::{ElementChoice, PalpationSetup, Place};
 use scene::phantom_spec::PhantomScene;
 use serde::{Deserialize, Deserializer};
 use std::path::Path;
@@ -362,10 +362,10 @@ impl CampaignSpec {
         base.tumours = p
             .tumours
             .iter()
-            .map(|t| TumourSetup {
+            .map(|t| phantom::Tumour {
                 center: [t.center[0].0, t.center[1].0, t.center[2].0],
                 radius: t.radius.0,
-                stiffness: t.stiffness.0,
+                stiffness_factor: t.stiffness.0,
             })
             .collect();
         if let Some(d) = self.hand.diameter {

@@ -32,12 +32,17 @@ impl std::str::FromStr for Variant {
     }
 }
 
-/// A spherical liver tumour; it becomes its own part ("tumour", "tumour2", ...).
-#[derive(Clone, Debug, PartialEq)]
+/// A spherical liver tumour; it becomes its own part ("tumour", "tumour2", ...). In JSON (a
+/// campaign's plan, a dataset's manifest) its lengths carry the unit in the key: `center_m`,
+/// `radius_m`.
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
 pub struct Tumour {
     /// Centre (m) in the phantom frame at respiratory phase 0; it moves with the liver.
+    #[serde(rename = "center_m")]
     pub center: [f64; 3],
     /// Radius (m).
+    #[serde(rename = "radius_m")]
     pub radius: f64,
     /// Stiffness relative to healthy liver (the caller scales the liver law by it).
     pub stiffness_factor: f64,

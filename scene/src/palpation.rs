@@ -15,7 +15,7 @@
 //! a tumour the liver law with its shear and Prony moduli scaled by the tumour's stiffness
 //! factor (so its Poisson ratio and relaxation times stay the liver's).
 
-use phantom::DEFAULT_VOXEL;
+use phantom::{Tumour, DEFAULT_VOXEL};
 use solver::element::{HourglassForm, HourglassModulus};
 use solver::model::StepTarget;
 use solver::output::history::{column, read_history};
@@ -157,17 +157,6 @@ impl std::str::FromStr for Fidelity {
     }
 }
 
-/// A liver tumour (SI).
-#[derive(Clone, Debug, PartialEq)]
-pub struct TumourSetup {
-    /// Centre (m).
-    pub center: [f64; 3],
-    /// Radius (m).
-    pub radius: f64,
-    /// Stiffness relative to healthy liver.
-    pub stiffness: f64,
-}
-
 /// Everything that defines one palpation. Lengths in m, times in s.
 #[derive(Clone, Debug, PartialEq)]
 pub struct PalpationSetup {
@@ -182,7 +171,7 @@ pub struct PalpationSetup {
     /// Respiratory phase 0..1.
     pub respiratory_phase: f64,
     /// Tumours.
-    pub tumours: Vec<TumourSetup>,
+    pub tumours: Vec<Tumour>,
     /// Where the fingers press.
     pub place: Place,
     /// Indentation depth (m).
@@ -309,7 +298,7 @@ impl PalpationSetup {
                 finite(c, "tumour centre")?;
             }
             pos(t.radius, "tumour radius")?;
-            pos(t.stiffness, "tumour stiffness")?;
+            pos(t.stiffness_factor, "tumour stiffness")?;
         }
         if let Place::At(x, y) = self.place {
             finite(x, "x of the place")?;

@@ -172,7 +172,7 @@ impl PalpationSetup {
                 .map(|t| TumourScene {
                     center: t.center.map(Length),
                     radius: Length(t.radius),
-                    stiffness: Number(t.stiffness),
+                    stiffness: Number(t.stiffness_factor),
                 })
                 .collect(),
             ..Default::default()
@@ -198,7 +198,7 @@ impl PalpationSetup {
         let materials: BTreeMap<String, MaterialSpec> = tumour_names
             .iter()
             .zip(&self.tumours)
-            .map(|(n, t)| (n.clone(), scaled_liver_spec(t.stiffness)))
+            .map(|(n, t)| (n.clone(), scaled_liver_spec(t.stiffness_factor)))
             .collect();
         let parts = PART_MATERIALS
             .iter()
@@ -333,7 +333,7 @@ impl PalpationSetup {
                     t.center[1],
                     t.center[2],
                     t.radius,
-                    toml_num(t.stiffness)
+                    toml_num(t.stiffness_factor)
                 );
             }
             s.push_str("]\n");
@@ -354,7 +354,11 @@ impl PalpationSetup {
             .map(phantom::tumour_part_name)
             .collect();
         for (n, t) in tumour_names.iter().zip(&self.tumours) {
-            let _ = writeln!(s, "[materials.{n}]\n{}", scaled_liver_card(t.stiffness));
+            let _ = writeln!(
+                s,
+                "[materials.{n}]\n{}",
+                scaled_liver_card(t.stiffness_factor)
+            );
         }
         for (p, m) in &PART_MATERIALS {
             let _ = writeln!(s, "[[part]]\nname = {p:?}\nmaterial = {m:?}\n{}\n", el(p));
@@ -449,7 +453,8 @@ const HAND_LENGTH: f64 = 0.06;
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::palpation::{Fidelity, TumourSetup};
+    use crate::palpation::Fidelity;
+    use phantom::Tumour;
     use solver::element::precision::Precision;
     use solver::model::StepTarget;
 
@@ -463,15 +468,15 @@ mod tests {
             title: "P07 \"quoted\" \\ tab\t bell\u{7} nul\u{0} é".into(),
             place: Place::At(-0.0725, 0.1815),
             tumours: vec![
-                TumourSetup {
+                Tumour {
                     center: [-0.06, 0.18, 0.15],
                     radius: 0.01,
-                    stiffness: 5.0,
+                    stiffness_factor: 5.0,
                 },
-                TumourSetup {
+                Tumour {
                     center: [-0.05, 0.2, 0.14],
                     radius: 0.008,
-                    stiffness: 2e16,
+                    stiffness_factor: 2e16,
                 },
             ],
             mass_scaling: Some(StepTarget::Step(4e-6)),
@@ -522,10 +527,10 @@ mod tests {
                 ..Default::default()
             },
             PalpationSetup {
-                tumours: vec![TumourSetup {
+                tumours: vec![Tumour {
                     center: [0.0, 0.1, f64::INFINITY],
                     radius: 0.01,
-                    stiffness: 2.0,
+                    stiffness_factor: 2.0,
                 }],
                 ..Default::default()
             },
