@@ -276,6 +276,15 @@ mod tests {
         assert!(e.to_string().contains("voxels"), "{e}");
         let spec: CampaignSpec = toml::from_str("[locations]\ntrain = [\"A\"]\n").unwrap();
         assert!(spec.resolve().unwrap_err().contains("twice"));
+        let e = toml::from_str::<CampaignSpec>(
+            "[[locations.raster]]\ncenter = [\"0 m\", \"0.2 m\"]\nspacing = [\"1 cm\", \"1 cm\"]\nn = [2, 2]\nsplit = \"tran\"\n",
+        )
+        .unwrap_err()
+        .to_string();
+        assert!(
+            e.contains("tran") && e.contains("train") && e.contains("line 5"),
+            "{e}"
+        );
         // a scene's [mesh.phantom] keys that a campaign's runs leave at their defaults
         let spec: CampaignSpec = toml::from_str("[phantom]\ncoarsen = 2\n").unwrap();
         let e = spec.resolve().unwrap_err();

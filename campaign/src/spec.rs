@@ -83,7 +83,7 @@ pub struct RasterSpec {
     /// Points along x and y.
     pub n: [usize; 2],
     /// `train` or `test`.
-    pub split: String,
+    pub split: Split,
     /// Label prefix (default "R"): R01, R02, ...
     pub prefix: Option<String>,
 }
@@ -235,15 +235,7 @@ fn entry_locations(e: &LocationEntry, split: Split) -> Result<Vec<CampaignLocati
 }
 
 fn raster_locations(r: &RasterSpec) -> Result<(Split, Vec<CampaignLocation>), String> {
-    let split = match r.split.as_str() {
-        "train" => Split::Train,
-        "test" => Split::Test,
-        o => {
-            return Err(format!(
-                "locations.raster: split `{o}` is not train or test"
-            ))
-        }
-    };
+    let split = r.split;
     let prefix = r.prefix.clone().unwrap_or_else(|| "R".into());
     check_label(&prefix)?;
     let [nx, ny] = r.n;
