@@ -59,6 +59,30 @@ pub enum RunEvent<'a> {
     },
 }
 
+/// How many runs go side by side, and the worker threads of each.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct Parallelism {
+    /// Runs side by side.
+    pub jobs: usize,
+    /// Worker threads per run.
+    pub threads: usize,
+}
+
+impl Parallelism {
+    /// The given `jobs` and `threads`, or by default as many jobs as `cores` (at most one a run
+    /// to do) and the cores split between them.
+    pub fn choose(
+        jobs: Option<usize>,
+        threads: Option<usize>,
+        runs: usize,
+        cores: usize,
+    ) -> Parallelism {
+        let jobs = jobs.unwrap_or(cores).min(runs).max(1);
+        let threads = threads.unwrap_or((cores / jobs).max(1));
+        Parallelism { jobs, threads }
+    }
+}
+
 /// What [`execute`] did.
 pub struct Report {
     /// Runs finished.
@@ -204,4 +228,24 @@ pub fn run_one(
     };
     write_done(&dir, &m)?;
     Ok(m)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::Parallelism;
+
+    /// On 2 cores: two runs side by side with one thread each; one run left gets both cores;
+    /// what is given is kept (at most one job a run).
+    #[test]
+    fn parallelism_splits_the_cores_between_the_runs() {
+        let p = |j, t, n, c| {
+            let p = Parallelism::choose(j, t, n, c);
+            (p.jobs, p.threads)
+        };
+        assert_eq!(p(None, None, 28, 2), (2, 1));
+        assert_eq!(p(None, None, 1, 2), (1, 2));
+        assert_eq!(p(None, None, 0, 2), (1, 2));
+        assert_eq!(p(Some(4), None, 3, 16), (3, 5));
+        assert_eq!(p(Some(1), Some(2), 28, 2), (1, 2));
+    }
 }

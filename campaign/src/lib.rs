@@ -71,6 +71,7 @@ mod dir;
 mod execute;
 mod json_file;
 mod merge;
+mod outcome;
 mod phantom_record;
 mod plan;
 mod run_files;
@@ -79,9 +80,10 @@ mod spec;
 
 pub use assemble::{assemble, write_dataset};
 pub use dir::{campaign_file, first_difference, prepare_dir, read_campaign_dir, CampaignDir};
-pub use execute::{execute, run_one, Report, RunEvent};
+pub use execute::{execute, run_one, Parallelism, Report, RunEvent};
 pub use json_file::{read_json, write_json};
 pub use merge::{merge, MergeReport};
+pub use outcome::{finish, Outcome};
 
 pub use phantom_record::{GridRecord, PhantomRecord};
 pub use plan::{

@@ -54,6 +54,14 @@ pub struct Campaign {
 }
 
 impl Campaign {
+    /// The runs of `shard` (all runs when `None`), in order.
+    pub fn runs_of(&self, shard: Option<(usize, usize)>) -> Vec<&PlannedRun> {
+        self.runs
+            .iter()
+            .filter(|r| shard.is_none_or(|s| crate::shard::in_shard(r.index, s)))
+            .collect()
+    }
+
     /// The palpation of run `r`.
     pub fn setup(&self, r: &PlannedRun) -> PalpationSetup {
         PalpationSetup {

@@ -27,8 +27,8 @@
 
 use super::progress::{stop_flag, time_bar};
 use campaign::{
-    assemble, in_shard, read_done, resolve_shard, run_dir, write_dataset, Campaign, CampaignPlan,
-    CampaignSpec, PlannedRun, Report, RunEvent, Split,
+    read_done, resolve_shard, run_dir, Campaign, CampaignSpec, Outcome, Parallelism, PlannedRun,
+    Report, RunEvent, Split,
 };
 use phantom::Phantom;
 use std::path::{Path, PathBuf};
@@ -136,14 +136,7 @@ fn run_campaign(a: &CampaignArgs) -> Result<(), String> {
     let build_s = t0.elapsed().as_secs_f64();
     let locs = campaign.resolve_locations(&phantom)?;
     let plan = campaign.plan(&phantom, &locs);
-    let mine: Vec<&PlannedRun> = campaign
-        .runs
-        .iter()
-        .filter(|r| match shard {
-            Some(s) => in_shard(r.index, s),
-            None => true,
-        })
-        .collect();
+    let mine = campaign.runs_of(shard);
     let out = &a.out;
     let done: Vec<bool> = mine
         .iter()
@@ -190,8 +183,7 @@ fn run_campaign(a: &CampaignArgs) -> Result<(), String> {
         .map(|(r, _)| *r)
         .take(a.max_runs.unwrap_or(usize::MAX))
         .collect();
-    let jobs = a.jobs.unwrap_or_else(cores).min(todo.len()).max(1);
-    let threads = a.threads.unwrap_or_else(|| (cores() / jobs).max(1));
+    let Parallelism { jobs, threads } = Parallelism::choose(a.jobs, a.threads, todo.len(), cores());
     if !a.quiet {
         println!(
             "  {} finished, {} to run: {} side by side, {} thread(s) each; output {}",
@@ -214,52 +206,22 @@ fn run_campaign(a: &CampaignArgs) -> Result<(), String> {
             report.run_seconds
         );
     }
-    finish(a, &report, &plan, &mine, shard.is_some())
-}
-
-/// After the runs: refuse failed runs, name unfinished ones, or write the dataset.
-fn finish(
-    a: &CampaignArgs,
-    report: &Report,
-    plan: &CampaignPlan,
-    mine: &[&PlannedRun],
-    sharded: bool,
-) -> Result<(), String> {
-    let out = &a.out;
-    if !report.failed.is_empty() {
-        let list: Vec<String> = report
-            .failed
-            .iter()
-            .map(|(l, e)| format!("  {l}: {e}"))
-            .collect();
-        return Err(format!(
-            "{} run(s) failed (rerun with --resume to retry them):\n{}",
-            report.failed.len(),
-            list.join("\n")
-        ));
-    }
-    let missing: Vec<&str> = mine
-        .iter()
-        .filter(|r| read_done(&run_dir(out, &r.label)).is_none())
-        .map(|r| r.label.as_str())
-        .collect();
-    if !missing.is_empty() {
-        println!(
-            "  {} run(s) not finished ({}); continue with --resume",
-            missing.len(),
-            missing.join(", ")
-        );
-        return if report.stopped {
-            Err("stopped".into())
-        } else {
-            Ok(())
-        };
-    }
-    let labels: Vec<String> = mine.iter().map(|r| r.label.clone()).collect();
-    let ds = assemble(plan, &labels, |l| run_dir(out, l))?;
-    write_dataset(&ds, out)?;
-    if !a.quiet {
-        print_dataset(&ds, out, sharded);
+    match campaign::finish(&a.out, &report, &plan, &mine)? {
+        Outcome::Unfinished(missing) => {
+            println!(
+                "  {} run(s) not finished ({}); continue with --resume",
+                missing.len(),
+                missing.join(", ")
+            );
+            if report.stopped {
+                return Err("stopped".into());
+            }
+        }
+        Outcome::Dataset(ds) => {
+            if !a.quiet {
+                print_dataset(&ds, &a.out, shard.is_some());
+            }
+        }
     }
     Ok(())
 }
