@@ -11,25 +11,7 @@ use criterion::{black_box, criterion_group, criterion_main, Criterion, Throughpu
 
 fn setup(n: usize) -> (ContactStage, Vec<[f64; 3]>) {
     let h = 2.8e-3;
-    let mut x = Vec::with_capacity((n + 1) * (n + 1));
-    for j in 0..=n {
-        for i in 0..=n {
-            x.push([i as f64 * h, j as f64 * h, 0.0]);
-        }
-    }
-    let id = |i: usize, j: usize| (j * (n + 1) + i) as u32;
-    let mut faces = Vec::with_capacity(n * n);
-    for j in 0..n {
-        for i in 0..n {
-            faces.push([id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1)]);
-        }
-    }
-    let nf = faces.len();
-    let surface = ContactSurface {
-        faces,
-        face_bulk_modulus: vec![2e9; nf],
-        face_element_volume: vec![h * h * h; nf],
-    };
+    let (mut x, surface) = ContactSurface::flat_grid(n, h, 2e9);
     let c = n as f64 * h / 2.0;
     let hand = HandSpec {
         name: "hand".into(),

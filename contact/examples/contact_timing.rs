@@ -10,25 +10,8 @@ use std::time::Instant;
 fn main() {
     let n: usize = std::env::args().nth(1).map_or(317, |s| s.parse().unwrap());
     let h = 2.8e-3;
-    let mut x0 = Vec::with_capacity((n + 1) * (n + 1));
-    for j in 0..=n {
-        for i in 0..=n {
-            x0.push([i as f64 * h, j as f64 * h, 0.0]);
-        }
-    }
-    let id = |i: usize, j: usize| (j * (n + 1) + i) as u32;
-    let mut faces = Vec::with_capacity(n * n);
-    for j in 0..n {
-        for i in 0..n {
-            faces.push([id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1)]);
-        }
-    }
-    let nf = faces.len();
-    let surface = ContactSurface {
-        faces,
-        face_bulk_modulus: vec![2e9; nf],
-        face_element_volume: vec![h * h * h; nf],
-    };
+    let (x0, surface) = ContactSurface::flat_grid(n, h, 2e9);
+    let nf = surface.faces.len();
     let m = 1060.0 * h * h * h;
     let c = n as f64 * h / 2.0;
     let hand = HandSpec {

@@ -104,6 +104,33 @@ pub struct RayHit {
 }
 
 impl ContactSurface {
+    /// A flat `n x n` grid of square faces of edge `h` (m) in the plane z = 0, spanning
+    /// `[0, n h]^2`, outward normal +z, every face owned by a cube of edge `h` with bulk
+    /// modulus `bulk` (Pa): the surface of the contact tests, benchmarks and timing example.
+    /// Returns the node positions (x fastest) and the surface.
+    pub fn flat_grid(n: usize, h: f64, bulk: f64) -> (Vec<[f64; 3]>, ContactSurface) {
+        let mut x = Vec::with_capacity((n + 1) * (n + 1));
+        for j in 0..=n {
+            for i in 0..=n {
+                x.push([i as f64 * h, j as f64 * h, 0.0]);
+            }
+        }
+        let id = |i: usize, j: usize| (j * (n + 1) + i) as u32;
+        let mut faces = Vec::with_capacity(n * n);
+        for j in 0..n {
+            for i in 0..n {
+                faces.push([id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1)]);
+            }
+        }
+        let nf = faces.len();
+        let surface = ContactSurface {
+            faces,
+            face_bulk_modulus: vec![bulk; nf],
+            face_element_volume: vec![h * h * h; nf],
+        };
+        (x, surface)
+    }
+
     /// First hit of the ray `origin + s * direction` (s >= 0) with the faces at positions `x`
     /// (each quad split into two triangles). `O(N_faces)`: for placing indenters, not per step.
     pub fn raycast(&self, x: &[[f64; 3]], origin: [f64; 3], direction: [f64; 3]) -> Option<RayHit> {

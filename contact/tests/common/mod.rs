@@ -4,31 +4,10 @@
 
 use contact::*;
 
-/// A flat `n x n` grid of square faces of size `h` (m) in the plane z = 0, spanning
-/// `[0, n h]^2`, outward normal +z. Returns (positions, surface).
+/// A flat `n x n` grid of square faces of size `h` (m) in the plane z = 0
+/// ([`ContactSurface::flat_grid`]). Returns (positions, surface).
 pub fn flat_grid(n: usize, h: f64, bulk: f64) -> (Vec<[f64; 3]>, ContactSurface) {
-    let mut x = Vec::with_capacity((n + 1) * (n + 1));
-    for j in 0..=n {
-        for i in 0..=n {
-            x.push([i as f64 * h, j as f64 * h, 0.0]);
-        }
-    }
-    let id = |i: usize, j: usize| (j * (n + 1) + i) as u32;
-    let mut faces = Vec::with_capacity(n * n);
-    for j in 0..n {
-        for i in 0..n {
-            faces.push([id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j + 1)]);
-        }
-    }
-    let nf = faces.len();
-    (
-        x,
-        ContactSurface {
-            faces,
-            face_bulk_modulus: vec![bulk; nf],
-            face_element_volume: vec![h * h * h; nf],
-        },
-    )
+    ContactSurface::flat_grid(n, h, bulk)
 }
 
 pub fn sphere(name: &str, center: [f64; 3], radius: f64, motion: MotionSpec) -> IndenterSpec {
