@@ -6,38 +6,11 @@
 //! through them so that branch prediction and the table lookups see varied input.
 
 use criterion::{black_box, criterion_group, criterion_main, Criterion, Throughput};
-use material::{named, with_law, Law, Mat3, Material};
-
-fn gradients() -> Vec<Mat3> {
-    (0..64)
-        .map(|k| {
-            let s = k as f64 / 63.0;
-            let (a, b, c) = (
-                0.3 * s - 0.15,
-                0.1 * (s * 7.0).sin(),
-                0.05 * (s * 3.0).cos(),
-            );
-            let stretch = Mat3::new(
-                1.0 + a,
-                b,
-                0.0,
-                b * 0.5,
-                1.0 - 0.5 * a,
-                c,
-                0.0,
-                c * 0.3,
-                1.0 - 0.4 * a,
-            );
-            let rot =
-                nalgebra::Rotation3::from_euler_angles(0.2 * s, -0.4 * s, 0.7 * s).into_inner();
-            rot * stretch
-        })
-        .collect()
-}
+use material::{named, with_law, Law, Material};
 
 fn bench_law(c: &mut Criterion, label: &str, name: &str, dt: f64) {
     let m: Material = named(name).unwrap().build(name).unwrap();
-    let fs = gradients();
+    let fs = material::tensor::sample_gradients();
     let mut group = c.benchmark_group("laws");
     group.throughput(Throughput::Elements(1));
     with_law!(&m, law => {

@@ -5,42 +5,15 @@
 //!
 //! Usage: `law_loop NAME N` (NAME: paper:liver, paper:flesh, paper:ribs).
 
-use material::{named, with_law, Law, Mat3, Material};
+use material::{named, with_law, Law, Material};
 use std::hint::black_box;
-
-fn gradients() -> Vec<Mat3> {
-    (0..64)
-        .map(|k| {
-            let s = k as f64 / 63.0;
-            let (a, b, c) = (
-                0.3 * s - 0.15,
-                0.1 * (s * 7.0).sin(),
-                0.05 * (s * 3.0).cos(),
-            );
-            let stretch = Mat3::new(
-                1.0 + a,
-                b,
-                0.0,
-                b * 0.5,
-                1.0 - 0.5 * a,
-                c,
-                0.0,
-                c * 0.3,
-                1.0 - 0.4 * a,
-            );
-            let rot =
-                nalgebra::Rotation3::from_euler_angles(0.2 * s, -0.4 * s, 0.7 * s).into_inner();
-            rot * stretch
-        })
-        .collect()
-}
 
 fn main() {
     let args: Vec<String> = std::env::args().collect();
     let name = args.get(1).map(String::as_str).unwrap_or("paper:liver");
     let n: usize = args.get(2).and_then(|s| s.parse().ok()).unwrap_or(100_000);
     let m: Material = named(name).unwrap().build(name).unwrap();
-    let fs = gradients();
+    let fs = material::tensor::sample_gradients();
     let mut acc = 0.0;
     with_law!(&m, law => {
         let hl = law.history_len();

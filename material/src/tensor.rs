@@ -113,3 +113,33 @@ pub fn mul_sym<R: Real>(m: &M3<R>, s: &[R; 6]) -> M3<R> {
     let sm = [[s[0], s[3], s[5]], [s[3], s[1], s[4]], [s[5], s[4], s[2]]];
     mul(m, &sm)
 }
+
+/// 64 deformation gradients typical of an indentation step: a mix of stretch (up to 15 %),
+/// shear and rotation, varied so that a law's branches and table lookups see varied input.
+/// The input of the law benchmarks and the `law_loop` example.
+pub fn sample_gradients() -> Vec<Mat3> {
+    (0..64)
+        .map(|k| {
+            let s = k as f64 / 63.0;
+            let (a, b, c) = (
+                0.3 * s - 0.15,
+                0.1 * (s * 7.0).sin(),
+                0.05 * (s * 3.0).cos(),
+            );
+            let stretch = Mat3::new(
+                1.0 + a,
+                b,
+                0.0,
+                b * 0.5,
+                1.0 - 0.5 * a,
+                c,
+                0.0,
+                c * 0.3,
+                1.0 - 0.4 * a,
+            );
+            let rot =
+                nalgebra::Rotation3::from_euler_angles(0.2 * s, -0.4 * s, 0.7 * s).into_inner();
+            rot * stretch
+        })
+        .collect()
+}
