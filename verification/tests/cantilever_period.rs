@@ -1,100 +1,13 @@
-//! Free vibration against closed forms (issue 2). (The struck bar's wave front is the
-//! verification crate's `wave_arrival`, tested there and in `palpa verify`.)
-//!
-//! Cantilever free vibration: a clamped beam (nu = 0) started with the velocity of its first
-//! Euler-Bernoulli mode, v_z(x) = v0 phi(x), phi = cosh bx - cos bx - s (sinh bx - sin bx),
-//! bL = 1.87510, s = (cosh bL + cos bL)/(sinh bL + sin bL). The first period
-//! T = 2 pi / ((bL)^2 sqrt(E I / (rho A L^4))) must be matched within 3 %.
+//! Cantilever free vibration against beam theory (issue 2), on the verification case's beam
+//! ([`verification::cases::closed::cantilever_period`]): the first period of each element
+//! formulation on a fine and a coarse mesh, and the energy balance.
 
-use material::linear_elastic::{Kinematics, LinearElastic};
-use material::Material;
-use solver::bc::{Constraint, Kinematic};
 use solver::element::{Formulation, Hourglass};
-use solver::generate::{box_mesh, BoxSpec};
-use solver::model::{Model, Part};
-use solver::simulation::{LoopSettings, Simulation};
 
-fn elastic(e: f64, nu: f64, rho: f64) -> Material {
-    let (lambda, mu) = material::law::lame(e, nu);
-    Material::LinearElastic(LinearElastic {
-        rho,
-        lambda,
-        mu,
-        kinematics: Kinematics::Green,
-    })
-}
-
+/// Period over beam theory's, and the largest energy error, within `window` periods.
 fn cantilever_period(form: Formulation, div: [usize; 3], window: f64) -> (f64, f64) {
-    let (e, rho, l, h) = (1e6, 1000.0, 0.1, 0.01);
-    let mesh = box_mesh(
-        &BoxSpec {
-            size: [l, h, h],
-            divisions: div,
-            ..Default::default()
-        },
-        "beam",
-    )
-    .unwrap();
-    let clamp = mesh.node_sets["xmin"].clone();
-    let bl: f64 = 1.875_104_068_711_961;
-    let s = (bl.cosh() + bl.cos()) / (bl.sinh() + bl.sin());
-    let b = bl / l;
-    let phi = |x: f64| (b * x).cosh() - (b * x).cos() - s * ((b * x).sinh() - (b * x).sin());
-    let v0 = 1e-3;
-    let vel: Vec<[f64; 3]> = mesh
-        .nodes
-        .iter()
-        .map(|p| [0.0, 0.0, v0 * phi(p[0]) / phi(l)])
-        .collect();
-    let tip: Vec<u32> = mesh.node_sets["xmax"].clone();
-    let model = Model::build(
-        mesh,
-        vec![Part {
-            name: "beam".into(),
-            material: elastic(e, 0.0, rho),
-            formulation: form,
-        }],
-        None,
-        0.9,
-    )
-    .unwrap();
-    let c: Vec<Constraint> = (0..3)
-        .map(|d| Constraint {
-            nodes: clamp.clone(),
-            dof: d,
-            kind: Kinematic::Fixed,
-        })
-        .collect();
-    let mut sim = Simulation::new(
-        model,
-        LoopSettings::default(),
-        c,
-        Vec::new(),
-        Some(vel),
-        false,
-    )
-    .unwrap();
-    let t_eb = 2.0 * std::f64::consts::PI / (bl * bl * (e * h * h / 12.0 / rho / l.powi(4)).sqrt());
-    let mut crossings = Vec::new();
-    let mut prev = (0.0, 0.0);
-    let mut max_err: f64 = 0.0;
-    while sim.time < window * t_eb && crossings.len() < 2 {
-        sim.step(f64::INFINITY).unwrap();
-        let w: f64 = tip.iter().map(|&k| sim.u[k as usize][2]).sum::<f64>() / tip.len() as f64;
-        if sim.step > 1 && prev.1 * w < 0.0 {
-            crossings.push(prev.0 + (0.0 - prev.1) / (w - prev.1) * (sim.time - prev.0));
-        }
-        prev = (sim.time, w);
-        if sim.time > 0.05 * t_eb {
-            max_err = max_err.max(sim.energy.error());
-        }
-    }
-    assert!(
-        crossings.len() >= 2,
-        "too few zero crossings: {crossings:?}"
-    );
-    // Crossings at T/2 and T: the period is twice their spacing.
-    let t = 2.0 * (crossings[1] - crossings[0]);
+    let (t, t_eb, max_err, _) =
+        verification::cases::closed::cantilever_period(form, div, window).unwrap();
     println!(
         "{} {:?}: period {:.5} s, beam theory {:.5} s, ratio {:.4}, max energy error {:.2e}",
         form.label(),
