@@ -190,7 +190,7 @@ pub fn resolve_contact(
         }
     }
 
-    let (nodes, parts) = surface_selection(mesh, contact, &loc)?;
+    let surface = surface_selection(mesh, contact, &loc)?;
     let d = ContactScene::default();
     let mut params = contact_params(Some(contact.unwrap_or(&d)), 0.0)
         .map_err(|m| at("[contact]", "contact", &m))?;
@@ -198,11 +198,7 @@ pub fn resolve_contact(
     Ok(ContactDef {
         indenters: defs,
         hands: hand_defs,
-        surface: SurfaceSel {
-            nodes,
-            parts,
-            faces: None,
-        },
+        surface,
         params,
         origin: format!("{}: `contact`", path.display()),
         empty_hint: "check `surface` and `parts`".into(),
@@ -210,13 +206,13 @@ pub fn resolve_contact(
 }
 
 /// The contact surface's selection from `[contact]`: a node mask from `surface` (a node set)
-/// and a part mask from `parts`; `loc` places an error in the scene file.
-#[allow(clippy::type_complexity)]
+/// and a part mask from `parts` (no face list: that comes from a deck); `loc` places an error
+/// in the scene file.
 fn surface_selection(
     mesh: &Mesh,
     contact: Option<&ContactScene>,
     loc: &Locate,
-) -> Result<(Option<Vec<bool>>, Option<Vec<bool>>), String> {
+) -> Result<SurfaceSel, String> {
     let at = |needle: &str, key: &str, msg: &dyn std::fmt::Display| loc.err(key, Some(needle), msg);
     let c = contact;
     let nodes: Option<Vec<bool>> = match c.and_then(|c| c.surface.as_ref()) {
@@ -254,7 +250,11 @@ fn surface_selection(
             Some(ok)
         }
     };
-    Ok((nodes, parts))
+    Ok(SurfaceSel {
+        nodes,
+        parts,
+        faces: None,
+    })
 }
 
 /// Build the contact stage of a resolved scene: the surface from the mesh boundary (restricted

@@ -23,24 +23,10 @@ use std::collections::BTreeMap;
 use std::fmt::Write;
 use std::path::Path;
 
-/// `s` as a TOML basic string: quotes, backslashes and control characters escaped (the same
-/// text as Rust's `{:?}` for a printable string).
+/// `s` as a TOML string (the toml crate's quoting: a basic string `"..."` for an ordinary
+/// title, as Rust's `{:?}` writes it; escapes or a literal string where needed).
 fn toml_str(s: &str) -> String {
-    let mut out = String::with_capacity(s.len() + 2);
-    out.push('"');
-    for c in s.chars() {
-        match c {
-            '"' => out.push_str("\\\""),
-            '\\' => out.push_str("\\\\"),
-            '\n' => out.push_str("\\n"),
-            '\t' => out.push_str("\\t"),
-            '\r' => out.push_str("\\r"),
-            c if c.is_control() => out.push_str(&format!("\\u{:04X}", c as u32)),
-            c => out.push(c),
-        }
-    }
-    out.push('"');
-    out
+    toml::Value::String(s.to_string()).to_string()
 }
 
 /// A plain number as TOML reads it back: as Rust prints it, unless that would be an integer
@@ -515,6 +501,21 @@ mod tests {
                 format!("{:#?}", s.scene_spec()),
                 "{text}"
             );
+        }
+    }
+
+    /// An ordinary title or location is written as before (`{:?}`): the scene files of
+    /// earlier runs keep their bytes.
+    #[test]
+    fn ordinary_strings_are_quoted_as_before() {
+        for t in [
+            "palpation",
+            "paper protocol: P07",
+            "quick: A_d15mm_t25ms",
+            "reduced",
+            "B",
+        ] {
+            assert_eq!(toml_str(t), format!("{t:?}"));
         }
     }
 

@@ -8,13 +8,6 @@ use scene::load_scene;
 use solver::output::history::column;
 use std::path::Path;
 
-/// Linear interpolation of `y` at `x = x0` on a monotone increasing `x`.
-fn at(x: &[f64], y: &[f64], x0: f64) -> f64 {
-    let i = x.iter().position(|&v| v >= x0).expect("depth reached");
-    let (xa, xb, ya, yb) = (x[i - 1], x[i], y[i - 1], y[i]);
-    ya + (yb - ya) * (x0 - xa) / (xb - xa)
-}
-
 #[test]
 fn hertz_sphere_force_depth_matches_closed_form() {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes/hertz-sphere.toml");
@@ -33,8 +26,8 @@ fn hertz_sphere_force_depth_matches_closed_form() {
     let mut worst: f64 = 0.0;
     for k in 1..=5 {
         let d = 0.02 * k as f64 * r;
-        let f = 4.0 * at(&travel[..n], &fz[..n], d);
-        let g = at(&travel[..n], &pen[..n], d);
+        let f = 4.0 * common::interpolate_at(&travel[..n], &fz[..n], d);
+        let g = common::interpolate_at(&travel[..n], &pen[..n], d);
         let f_h = 4.0 / 3.0 * es * r.sqrt() * d.powf(1.5);
         let rel = (f - f_h) / f_h;
         worst = worst.max(rel.abs());

@@ -8,12 +8,6 @@ use scene::load_scene;
 use solver::output::history::column;
 use std::path::Path;
 
-fn at(x: &[f64], y: &[f64], x0: f64) -> f64 {
-    let i = x.iter().position(|&v| v >= x0).expect("depth reached");
-    let (xa, xb, ya, yb) = (x[i - 1], x[i], y[i - 1], y[i]);
-    ya + (yb - ya) * (x0 - xa) / (xb - xa)
-}
-
 #[test]
 fn flat_punch_force_matches_closed_form() {
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../scenes/flat-punch.toml");
@@ -31,13 +25,13 @@ fn flat_punch_force_matches_closed_form() {
     let mut worst: f64 = 0.0;
     for d in [0.05e-3, 0.075e-3, 0.1e-3] {
         let f = if d < 0.1e-3 {
-            4.0 * at(&travel[..n], &fz[..n], d)
+            4.0 * common::interpolate_at(&travel[..n], &fz[..n], d)
         } else {
             // Full depth: the end of the hold.
             4.0 * fz.last().unwrap()
         };
         let g = if d < 0.1e-3 {
-            at(&travel[..n], &pen[..n], d)
+            common::interpolate_at(&travel[..n], &pen[..n], d)
         } else {
             *pen.last().unwrap()
         };

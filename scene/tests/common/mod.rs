@@ -37,3 +37,10 @@ pub fn run_to_end(scene: &mut Scene, name: &str) -> (Vec<String>, Vec<Vec<f64>>)
     let h = solver::output::history::read_history(&out.join("history.csv")).unwrap();
     h
 }
+
+/// Linear interpolation of `y` at `x = x0` on a monotone increasing `x`.
+pub fn interpolate_at(x: &[f64], y: &[f64], x0: f64) -> f64 {
+    let i = x.iter().position(|&v| v >= x0).expect("x0 reached");
+    let (xa, xb, ya, yb) = (x[i - 1], x[i], y[i - 1], y[i]);
+    ya + (yb - ya) * (x0 - xa) / (xb - xa)
+}
