@@ -29,6 +29,8 @@ pub struct CampaignDir {
     pub plan_value: Value,
     /// The solver version that wrote it.
     pub solver_version: Value,
+    /// The file read (`DIR/campaign.json`).
+    pub file: std::path::PathBuf,
 }
 
 /// Read `dir`'s `campaign.json`; an error names the file when it is not a palpa campaign.
@@ -42,13 +44,15 @@ pub fn read_campaign_dir(dir: &Path) -> Result<CampaignDir, String> {
         shard: shard_in(&v, &file)?,
         plan_value: v.get("plan").cloned().unwrap_or(Value::Null),
         solver_version: v.get("solver_version").cloned().unwrap_or(Value::Null),
+        file,
     })
 }
 
 impl CampaignDir {
-    /// The typed plan.
+    /// The typed plan; an error names the file and the key.
     pub fn plan(&self) -> Result<CampaignPlan, String> {
         CampaignPlan::from_value(&self.plan_value)
+            .map_err(|e| format!("{}: {e}", self.file.display()))
     }
 }
 

@@ -6,7 +6,6 @@
 use crate::assemble::{assemble, write_dataset};
 use crate::dir::{campaign_file, first_difference, read_campaign_dir};
 use crate::json_file::{read_json, write_json};
-use crate::plan::CampaignPlan;
 use crate::run_files::{read_done, run_dir};
 use crate::{CAMPAIGN_FILE, DONE_FILE};
 use serde_json::Value;
@@ -48,13 +47,17 @@ pub struct MergeReport {
 /// the whole dataset, identical to an unsharded run's.
 pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<MergeReport, String> {
     let mut plan: Option<Value> = None;
+    let mut first = None;
     // the shard counts the directories record (an unsharded one counts as 1)
     let mut counts: Vec<usize> = Vec::new();
     for d in dirs {
         let cd = read_campaign_dir(d)?;
         counts.push(cd.shard.map_or(1, |(_, n)| n));
         match &plan {
-            None => plan = Some(cd.plan_value),
+            None => {
+                plan = Some(cd.plan_value.clone());
+                first = Some(cd);
+            }
             Some(p) if *p != cd.plan_value => {
                 let diff = first_difference(p, &cd.plan_value, "plan").unwrap_or_default();
                 return Err(format!(
@@ -69,7 +72,7 @@ pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<MergeReport, String> {
         }
     }
     let plan = plan.ok_or("merge: no directories")?;
-    let typed = CampaignPlan::from_value(&plan)?;
+    let typed = first.ok_or("merge: no directories")?.plan()?;
     let labels: Vec<String> = typed.runs.iter().map(|r| r.label.clone()).collect();
     refuse_stale_out(out, &plan, dirs)?;
     std::fs::create_dir_all(out).map_err(|e| format!("{}: {e}", out.display()))?;

@@ -294,12 +294,8 @@ impl CampaignPlan {
 
     /// Read a plan from JSON; an error names the missing or malformed key.
     pub fn from_value(v: &serde_json::Value) -> Result<CampaignPlan, String> {
-        serde_path_to_error::deserialize(v).map_err(|e| {
-            format!(
-                "campaign.json: the plan: {}",
-                crate::phantom_record::at_key(&e)
-            )
-        })
+        serde_path_to_error::deserialize(v)
+            .map_err(|e| format!("the plan: {}", crate::phantom_record::at_key(&e)))
     }
 
     /// The run labelled `label`.
