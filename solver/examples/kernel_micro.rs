@@ -1,11 +1,11 @@
 //! Times the one-point element kernel alone on one batch of eight elements held in cache:
 //! `cargo run --release -p solver --example kernel_micro`. Prints ns per element for the
 //! scalar kernel and the eight-lane kernel (f64 and f32 lanes on the baseline, and f64 lanes
-//! built for AVX-512 where available), with the viscous hourglass form of the press, and the law
-//! alone in eight `f64` lanes (ns per point). Every output of the kernel goes through
-//! `black_box`: an earlier version kept one force entry and the step, and LLVM dropped the rest of
-//! the force computation (it then read 28-35 ns per element for the flesh in `f32` lanes instead
-//! of 56-60).
+//! built for AVX-512 where available), with the stiffness hourglass form of `palpa bench`'s
+//! press case, and the law alone in eight `f64` lanes (ns per point). Every output of the
+//! kernel goes through `black_box`: an earlier version kept one force entry and the step, and
+//! LLVM could drop the rest of the force computation (it read 28-35 ns per element for the
+//! flesh in `f32` lanes; docs/performance.md has the corrected figures).
 use material::real::{F64x8, Real};
 use material::real_f32::F32x8;
 use material::{named, Material};
@@ -57,7 +57,7 @@ macro_rules! run {
             let o = one_point::compute_forces(
                 black_box($law),
                 black_box(&r),
-                HourglassForm::Viscous,
+                HourglassForm::Stiffness,
                 black_box(&x),
                 black_box(&u),
                 black_box(&u),
