@@ -2,7 +2,8 @@
 //! ([`verification::cases::closed::cantilever_period`]): the first period of each element
 //! formulation on a fine and a coarse mesh, and the energy balance.
 
-use solver::element::{Formulation, Hourglass};
+use solver::element::Formulation;
+use verification::cases::{ONE_POINT_PHYSICAL, ONE_POINT_STIFFNESS, ONE_POINT_VISCOUS};
 
 /// Period over beam theory's, and the largest energy error, within `window` periods.
 fn cantilever_period(form: Formulation, div: [usize; 3], window: f64) -> (f64, f64) {
@@ -23,12 +24,7 @@ fn cantilever_period(form: Formulation, div: [usize; 3], window: f64) -> (f64, f
 #[test]
 /// Same layering effect as the viscous form; the stiffness form adds only a little bending stiffness.
 fn cantilever_first_period_one_point_stiffness_hourglass() {
-    let hg = Hourglass {
-        form: solver::element::HourglassForm::Stiffness,
-        coefficient: 0.1,
-        modulus: solver::element::HourglassModulus::PWave,
-    };
-    let (ratio, err) = cantilever_period(Formulation::OnePoint(hg), [40, 4, 4], 1.3);
+    let (ratio, err) = cantilever_period(ONE_POINT_STIFFNESS, [40, 4, 4], 1.3);
     assert!(ratio > 1.0 && ratio < 1.05, "period ratio {ratio}");
     assert!(err < 0.01, "energy error {err}");
 }
@@ -46,8 +42,7 @@ fn cantilever_first_period_fully_integrated() {
 /// within 5 %, and longer than beam theory.
 #[test]
 fn cantilever_one_point_viscous_is_soft_by_layering() {
-    let (ratio, err) =
-        cantilever_period(Formulation::OnePoint(Hourglass::default()), [40, 4, 4], 1.3);
+    let (ratio, err) = cantilever_period(ONE_POINT_VISCOUS, [40, 4, 4], 1.3);
     assert!(ratio > 1.0 && ratio < 1.05, "period ratio {ratio}");
     assert!(err < 0.01, "energy error {err}");
 }
@@ -57,12 +52,7 @@ fn cantilever_one_point_viscous_is_soft_by_layering() {
 /// (period too long). Printed for the report; asserted only in direction.
 #[test]
 fn cantilever_coarse_mesh_formulations_differ() {
-    let hg = Hourglass {
-        form: solver::element::HourglassForm::Stiffness,
-        coefficient: 0.1,
-        modulus: solver::element::HourglassModulus::PWave,
-    };
-    let (r1, _) = cantilever_period(Formulation::OnePoint(hg), [10, 1, 1], 20.0);
+    let (r1, _) = cantilever_period(ONE_POINT_STIFFNESS, [10, 1, 1], 20.0);
     let (r2, _) = cantilever_period(Formulation::Full { fbar: false }, [10, 1, 1], 2.0);
     assert!(
         r2 < 1.0,
@@ -81,13 +71,8 @@ fn cantilever_coarse_mesh_formulations_differ() {
 /// stored, so the balance closes to 1 %.
 #[test]
 fn cantilever_first_period_one_point_physical_on_one_element_through_the_depth() {
-    let hg = Hourglass {
-        form: solver::element::HourglassForm::Physical,
-        coefficient: 1.0,
-        modulus: solver::element::HourglassModulus::Shear,
-    };
     for div in [[10, 1, 1], [20, 2, 2]] {
-        let (ratio, err) = cantilever_period(Formulation::OnePoint(hg), div, 1.3);
+        let (ratio, err) = cantilever_period(ONE_POINT_PHYSICAL, div, 1.3);
         assert!((ratio - 1.0).abs() < 0.03, "{div:?}: period ratio {ratio}");
         assert!(err < 0.01, "{div:?}: energy error {err}");
     }
