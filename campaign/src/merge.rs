@@ -4,7 +4,7 @@
 //! one of them, else the error names the missing runs and their shards.
 
 use crate::assemble::{assemble, write_dataset};
-use crate::dir::{campaign_file, first_difference, read_campaign_dir};
+use crate::dir::{campaign_file, first_difference, read_campaign_dir, CampaignDir};
 use crate::json_file::{read_json, write_json};
 use crate::run_files::{read_done, run_dir};
 use crate::{CAMPAIGN_FILE, DONE_FILE};
@@ -46,20 +46,18 @@ pub struct MergeReport {
 /// `palpa campaign merge DIRS --out OUT`: copy the shards' finished runs into `out` and write
 /// the whole dataset, identical to an unsharded run's.
 pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<MergeReport, String> {
-    let mut plan: Option<Value> = None;
-    let mut first = None;
+    // the first directory's campaign, which every other must equal
+    let mut first: Option<CampaignDir> = None;
     // the shard counts the directories record (an unsharded one counts as 1)
     let mut counts: Vec<usize> = Vec::new();
     for d in dirs {
         let cd = read_campaign_dir(d)?;
         counts.push(cd.shard.map_or(1, |(_, n)| n));
-        match &plan {
-            None => {
-                plan = Some(cd.plan_value.clone());
-                first = Some(cd);
-            }
-            Some(p) if *p != cd.plan_value => {
-                let diff = first_difference(p, &cd.plan_value, "plan").unwrap_or_default();
+        match &first {
+            None => first = Some(cd),
+            Some(f) if f.plan_value != cd.plan_value => {
+                let diff =
+                    first_difference(&f.plan_value, &cd.plan_value, "plan").unwrap_or_default();
                 return Err(format!(
                     "{} is a different campaign from {} ({diff}; there = {}, here = {})",
                     d.display(),
@@ -71,8 +69,9 @@ pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<MergeReport, String> {
             _ => {}
         }
     }
-    let plan = plan.ok_or("merge: no directories")?;
-    let typed = first.ok_or("merge: no directories")?.plan()?;
+    let first = first.ok_or("merge: no directories")?;
+    let typed = first.plan()?;
+    let plan = first.plan_value;
     let labels: Vec<String> = typed.runs.iter().map(|r| r.label.clone()).collect();
     refuse_stale_out(out, &plan, dirs)?;
     std::fs::create_dir_all(out).map_err(|e| format!("{}: {e}", out.display()))?;
