@@ -1,5 +1,6 @@
 //! The functions the `palpa train`, `palpa predict` and `palpa evaluate` commands call.
 
+use crate::coverage::{principal_variance_factor, Coverage, Z95};
 use crate::dataset::Dataset;
 use crate::domain::TrainingDomain;
 use crate::error::{Error, Result};
@@ -59,8 +60,45 @@ pub fn train(
     opts: &TrainOptions,
     out: &Path,
 ) -> Result<TrainReport> {
-    let data = Dataset::read(dataset)?;
-    let (model, report) = train_model(&data, kind, opts)?;
+    train_selected(dataset, &TrainingSelection::default(), kind, opts, out)
+}
+
+/// Which training samples of a dataset a model learns from ([`Dataset::select_training`]);
+/// the default keeps them all.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct TrainingSelection {
+    /// Only the first n training locations, in the dataset's order.
+    pub first_locations: Option<usize>,
+    /// Only samples at multiples of this interval (s).
+    pub interval: Option<f64>,
+    /// Learn the recovered stress target of this width (m; [`crate::recovery`]) instead of the
+    /// element stress.
+    pub recovery_width: Option<f64>,
+}
+
+impl TrainingSelection {
+    /// The dataset this selection trains on: its training samples, and its target.
+    pub fn apply(&self, data: &Dataset) -> Result<Dataset> {
+        let d = data.select_training(self.first_locations, self.interval)?;
+        match self.recovery_width {
+            Some(h) => d.recovered(h),
+            None => Ok(d),
+        }
+    }
+}
+
+/// As [`train`], on the training samples that `selection` keeps (the test samples are all
+/// scored either way).
+pub fn train_selected(
+    dataset: &Path,
+    selection: &TrainingSelection,
+    kind: ModelKind,
+    opts: &TrainOptions,
+    out: &Path,
+) -> Result<TrainReport> {
+    let data = selection.apply(&Dataset::read(dataset)?)?;
+    let (model, mut report) = train_model(&data, kind, opts)?;
+    report.recovery_width = selection.recovery_width;
     model.save_with_domain(
         out,
         data.roi_ids.as_slice().unwrap_or(&data.roi_ids.to_vec()),
@@ -95,6 +133,16 @@ pub fn train_model(
 ) -> Result<(TrainedModel, TrainReport)> {
     let (model, report, _) = fit_and_score(data, kind, opts)?;
     Ok((model, report))
+}
+
+/// As [`train_model`], also returning the model's prediction of every row of `data` (n x R
+/// ROI maximum principal stresses, Pa), so a caller can score any subset of rows.
+pub fn train_and_predict(
+    data: &Dataset,
+    kind: ModelKind,
+    opts: &TrainOptions,
+) -> Result<(TrainedModel, TrainReport, Array2<f64>)> {
+    fit_and_score(data, kind, opts)
 }
 
 /// Leave-one-location-out cross-validation of each configuration over every location of `data`
@@ -263,6 +311,7 @@ fn fit_and_score(
             map.apply(pred.predict_inputs(&xi)),
         ));
     }
+    let test_coverage_95 = interval_coverage(&mut pred, target, data, &test_rows);
     let latency_us = measure_latency(&mut pred, &mut map, &x3.select(Axis(0), &train_rows));
     let score = |rows: &[usize]| {
         compute_fit(
@@ -290,6 +339,11 @@ fn fit_and_score(
         .collect();
         (Some(score(&test_rows)), by)
     };
+    let paper_rows = paper_time_rows(data, &test_rows);
+    let test_fit_paper_times = (paper_rows.len() >= 2 && paper_rows.len() < test_rows.len())
+        .then(|| score(&paper_rows))
+        .filter(|f| f.is_finite());
+    let train_locations = data.training_location_order();
     let report = TrainReport {
         kind,
         target,
@@ -303,10 +357,63 @@ fn fit_and_score(
         train_fit,
         test_fit,
         test_fit_by_location,
+        test_fit_paper_times,
+        test_coverage_95,
+        n_train_locations: train_locations.len(),
+        recovery_width: None,
         latency_us,
         settings,
     };
     Ok((model, report, yhat))
+}
+
+/// The rows of `rows` sampled at a multiple of [`crate::PAPER_SAMPLE_INTERVAL`]; all of them
+/// when the dataset has no time column.
+fn paper_time_rows(data: &Dataset, rows: &[usize]) -> Vec<usize> {
+    let dt = crate::PAPER_SAMPLE_INTERVAL;
+    let tol = data.stamp_tolerance(dt);
+    match data.manifest.x_columns.iter().position(|c| c == "time") {
+        Some(t) => rows
+            .iter()
+            .copied()
+            .filter(|&i| crate::dataset::on_stamp(data.x[(i, t)], dt, tol))
+            .collect(),
+        None => rows.to_vec(),
+    }
+}
+
+/// Fraction of the ROI stresses of `rows` inside the GP's 95 % predictive interval
+/// (`coverage`); `None` for an MLP or no rows.
+fn interval_coverage(
+    pred: &mut PredictorImpl,
+    target: Target,
+    data: &Dataset,
+    rows: &[usize],
+) -> Option<f64> {
+    let PredictorImpl::Gp(g) = pred else {
+        return None;
+    };
+    let noise = g.noise_variance();
+    let mut map = TargetMap::new(target, data.n_roi());
+    let mut cov = Coverage::default();
+    let mut var = vec![0.0; data.n_roi()];
+    for &i in rows {
+        let xi = [data.x[(i, 0)], data.x[(i, 1)], data.x[(i, 2)]];
+        let (raw, latent) = g.predict_with_variance(&xi);
+        let v = latent + noise;
+        match target {
+            Target::Principal => var.iter_mut().for_each(|w| *w = v),
+            Target::Tensor => {
+                for (w, s) in var.iter_mut().zip(raw.chunks_exact(6)) {
+                    *w = v * principal_variance_factor(s);
+                }
+            }
+        }
+        let mean = map.apply(raw);
+        let y = data.y.row(i);
+        cov.add(y.as_slice().unwrap_or(&y.to_vec()), mean, &var, Z95);
+    }
+    cov.fraction()
 }
 
 /// Mean latency [us] of one prediction (raw outputs mapped to the principal stress) over the

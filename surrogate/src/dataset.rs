@@ -19,7 +19,7 @@
 //! half-written dataset.
 
 use crate::error::{Error, Result};
-use ndarray::{Array1, Array2, Array3, ArrayBase, DataOwned, Dimension};
+use ndarray::{Array1, Array2, Array3, ArrayBase, Axis, DataOwned, Dimension};
 use ndarray_npy::{NpzReader, NpzWriter, ReadableElement};
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
@@ -106,6 +106,11 @@ pub struct Dataset {
     pub manifest: Manifest,
 }
 
+/// Whether a sample time `t` (s) is a multiple of `interval` to within `tolerance` (s).
+pub fn on_stamp(t: f64, interval: f64, tolerance: f64) -> bool {
+    (t - (t / interval).round() * interval).abs() <= tolerance
+}
+
 /// The `.npz` and manifest paths for `path`: `path` itself and `path` with extension `.json`
 /// when it ends in `.npz`; otherwise `path/dataset.npz` and `path/manifest.json`.
 pub fn dataset_paths(path: &Path) -> (PathBuf, PathBuf) {
@@ -132,6 +137,115 @@ impl Dataset {
         (0..self.n_samples())
             .filter(|&i| self.split[i] == split.code())
             .collect()
+    }
+
+    /// The dataset with fewer training samples (test samples untouched): only the first
+    /// `first_locations` training locations in the order they appear (a campaign's order, so
+    /// the first n points of a Sobol design), and only samples at multiples of `interval` (s;
+    /// [`on_stamp`]). An error names a selection that keeps no training sample.
+    pub fn select_training(
+        &self,
+        first_locations: Option<usize>,
+        interval: Option<f64>,
+    ) -> Result<Dataset> {
+        let order = self.training_location_order();
+        let keep_loc: Vec<i64> = match first_locations {
+            Some(n) if n > order.len() => {
+                return Err(Error::invalid(
+                    "train locations",
+                    format!(
+                        "asked for the first {n}, the dataset has {} training locations",
+                        order.len()
+                    ),
+                ))
+            }
+            Some(n) => order[..n].to_vec(),
+            None => order,
+        };
+        let time_col = self.manifest.x_columns.iter().position(|c| c == "time");
+        if let Some(dt) = interval {
+            if !(dt > 0.0 && dt.is_finite()) {
+                return Err(Error::invalid(
+                    "train interval",
+                    format!("{dt} s is not a positive time"),
+                ));
+            }
+            if time_col.is_none() {
+                return Err(Error::invalid(
+                    "train interval",
+                    "the dataset has no `time` column",
+                ));
+            }
+        }
+        let tol = interval.map(|dt| self.stamp_tolerance(dt));
+        let on_stamp = |i: usize| match (interval, time_col, tol) {
+            (Some(dt), Some(c), Some(tol)) => on_stamp(self.x[(i, c)], dt, tol),
+            _ => true,
+        };
+        let rows: Vec<usize> = (0..self.n_samples())
+            .filter(|&i| {
+                self.split[i] != crate::Split::Train.code()
+                    || (keep_loc.contains(&self.location[i]) && on_stamp(i))
+            })
+            .collect();
+        if !rows
+            .iter()
+            .any(|&i| self.split[i] == crate::Split::Train.code())
+        {
+            return Err(Error::invalid(
+                "train selection",
+                "keeps no training sample",
+            ));
+        }
+        Ok(Dataset {
+            x: self.x.select(Axis(0), &rows),
+            y: self.y.select(Axis(0), &rows),
+            stress: self.stress.as_ref().map(|s| s.select(Axis(0), &rows)),
+            roi_ids: self.roi_ids.clone(),
+            roi_centroids: self.roi_centroids.clone(),
+            location: self.location.select(Axis(0), &rows),
+            split: self.split.select(Axis(0), &rows),
+            manifest: self.manifest.clone(),
+        })
+    }
+
+    /// The training locations in the order their first sample appears (a campaign's order).
+    pub fn training_location_order(&self) -> Vec<i64> {
+        let mut order: Vec<i64> = Vec::new();
+        for i in self.rows_with_split(crate::Split::Train) {
+            if !order.contains(&self.location[i]) {
+                order.push(self.location[i]);
+            }
+        }
+        order
+    }
+
+    /// The tolerance (s) within which a sample is taken to lie on a stamp of `interval`: a
+    /// quarter of the samples' own spacing (the smallest gap between two times of one
+    /// location), at most a tenth of the interval. A campaign samples at the step nearest
+    /// each stamp, a step (microseconds) off; a neighbouring sample lies a spacing away.
+    pub fn stamp_tolerance(&self, interval: f64) -> f64 {
+        let Some(c) = self.manifest.x_columns.iter().position(|c| c == "time") else {
+            return 0.1 * interval;
+        };
+        let mut by_loc: BTreeMap<i64, Vec<f64>> = BTreeMap::new();
+        for i in 0..self.n_samples() {
+            by_loc
+                .entry(self.location[i])
+                .or_default()
+                .push(self.x[(i, c)]);
+        }
+        let mut gap = f64::INFINITY;
+        for t in by_loc.values_mut() {
+            t.sort_by(f64::total_cmp);
+            for w in t.windows(2) {
+                let d = w[1] - w[0];
+                if d > 0.0 {
+                    gap = gap.min(d);
+                }
+            }
+        }
+        (0.25 * gap).min(0.1 * interval)
     }
 
     /// Label of location `id`: the manifest's label, or `loc-ID` when it has none.

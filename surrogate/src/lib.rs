@@ -13,7 +13,9 @@
 //!   by marginal likelihood, predictive variance.
 //! - [`target`]: what a model learns, the principal stress itself or the stress tensor whose
 //!   largest eigenvalue ([`principal`]) it reports.
-//! - [`fit`]: paper eq. 5, per location and overall.
+//! - [`recovery`]: the recovered stress target, element stresses averaged over a stated width.
+//! - [`fit`]: paper eq. 5, per location and overall; [`coverage`]: how often held-out values
+//!   fall inside the GP's 95 % intervals.
 //! - [`model`]: safetensors + JSON model files and the serving [`Predictor`].
 //! - [`api`]: [`train`], [`predict`], [`evaluate`] for the command line.
 //! - [`domain`]: what a model was trained on (recorded in `model.json`) and whether an input
@@ -32,6 +34,7 @@
 
 pub mod api;
 pub mod colour;
+pub mod coverage;
 pub mod dataset;
 pub mod domain;
 pub mod error;
@@ -46,6 +49,7 @@ pub mod model;
 pub mod model_kind;
 pub mod normalise;
 pub mod principal;
+pub mod recovery;
 pub mod render;
 pub mod report;
 pub mod rng;
@@ -58,8 +62,8 @@ pub mod tensor_file;
 pub mod view;
 
 pub use api::{
-    default_evaluation_configs, evaluate, predict, train, train_model, ModelConfig, Prediction,
-    TrainOptions,
+    default_evaluation_configs, evaluate, predict, train, train_and_predict, train_model,
+    train_selected, ModelConfig, Prediction, TrainOptions, TrainingSelection,
 };
 pub use colour::ColourScale;
 pub use dataset::{Dataset, Manifest};
@@ -73,4 +77,8 @@ pub use report::{CostRow, EvaluationReport, LocationFit, TrainReport};
 pub use serving::{Served, ServedModel, Warning};
 pub use split::Split;
 pub use target::Target;
+
+/// The paper's sampling interval (s): its six samples a run, at 0, 5, ..., 25 ms. Datasets
+/// sampled more densely are also scored at these stamps alone ([`TrainReport`]).
+pub const PAPER_SAMPLE_INTERVAL: f64 = 0.005;
 pub use view::ViewGeometry;

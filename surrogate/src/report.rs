@@ -54,6 +54,22 @@ pub struct TrainReport {
     pub test_fit: Option<f64>,
     /// Fit per test location.
     pub test_fit_by_location: Vec<LocationFit>,
+    /// Fit on the test samples at the paper's time stamps (multiples of
+    /// [`crate::PAPER_SAMPLE_INTERVAL`]) when the test set also holds samples between them;
+    /// `None` otherwise.
+    #[serde(with = "crate::json_f64::option", default)]
+    pub test_fit_paper_times: Option<f64>,
+    /// Fraction of the test samples' ROI stresses inside the GP's 95 % predictive interval
+    /// (`coverage`); `None` for an MLP or without test samples.
+    #[serde(with = "crate::json_f64::option", default)]
+    pub test_coverage_95: Option<f64>,
+    /// Training locations (distinct location ids among the training samples).
+    #[serde(default)]
+    pub n_train_locations: usize,
+    /// Width (m) of the recovered stress target the model learned and was scored on
+    /// ([`crate::recovery`]); `None` for the element stress.
+    #[serde(default)]
+    pub recovery_width: Option<f64>,
     /// Mean single-prediction latency of the serving predictor [us], one thread.
     pub latency_us: f64,
     /// Training settings, as JSON.
@@ -64,17 +80,25 @@ impl fmt::Display for TrainReport {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         writeln!(
             f,
-            "model {} on the {} target ({}, {} parameters), {} training samples, trained in {:.2} s{}",
+            "model {} on the {} target ({}, {} parameters), {} training samples from {} locations, trained in {:.2} s{}",
             self.kind,
             self.target,
             self.size,
             self.n_params,
             self.n_train,
+            self.n_train_locations,
             self.train_seconds,
             self.epochs
                 .map(|e| format!(" ({e} epochs)"))
                 .unwrap_or_default()
         )?;
+        if let Some(h) = self.recovery_width {
+            writeln!(
+                f,
+                "target: the recovered stress, element stresses averaged over a Gaussian of width {:.3} mm (every Fit below is against the recovered field)",
+                h * 1e3
+            )?;
+        }
         writeln!(f, "Fit on training samples: {:.4}", self.train_fit)?;
         for l in &self.test_fit_by_location {
             writeln!(
@@ -86,6 +110,20 @@ impl fmt::Display for TrainReport {
         match self.test_fit {
             Some(v) => writeln!(f, "Fit on all {} test samples: {:.4}", self.n_test, v)?,
             None => writeln!(f, "no test samples (split == 1) in the dataset")?,
+        }
+        if let Some(v) = self.test_fit_paper_times {
+            writeln!(
+                f,
+                "Fit on the test samples at the paper's time stamps (every {} ms): {v:.4}",
+                crate::PAPER_SAMPLE_INTERVAL * 1e3
+            )?;
+        }
+        if let Some(c) = self.test_coverage_95 {
+            writeln!(
+                f,
+                "95 % predictive intervals cover {:.1} % of the test samples' ROI stresses",
+                100.0 * c
+            )?;
         }
         write!(f, "prediction latency: {:.1} us", self.latency_us)
     }

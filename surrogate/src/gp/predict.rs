@@ -125,6 +125,24 @@ impl GpPredictor {
         &self.out
     }
 
+    /// The kernel's length scales in physical input units (m, m, N): the normalised length
+    /// scale times the input's standard deviation.
+    pub fn physical_length_scales(&self) -> Vec<f64> {
+        self.kernel
+            .length_scales
+            .iter()
+            .zip(&self.input_scaling.std)
+            .map(|(l, s)| l * s)
+            .collect()
+    }
+
+    /// The noise variance [Pa^2] of an observed output (`sn2 s_y^2`): add it to the latent
+    /// variance for the predictive variance of a value the solver would give.
+    pub fn noise_variance(&self) -> f64 {
+        let s_y = self.output_scaling.std.first().copied().unwrap_or(1.0);
+        self.kernel.noise_variance * s_y * s_y
+    }
+
     /// Predictive mean [Pa] and latent variance [Pa^2] (shared by all outputs) at `inputs`.
     pub fn predict_with_variance(&mut self, inputs: &[f64]) -> (&[f64], f64) {
         self.predict_inputs(inputs);
