@@ -142,6 +142,19 @@ pub fn prepare_dir(
     write_json(&cfile, &desc)
 }
 
+/// Write `out`'s `campaign.json` for `plan` and `shard` (atomically), as [`prepare_dir`] does
+/// once it has checked the directory; an adaptive campaign writes it again after each batch.
+pub fn write_campaign_file(
+    out: &Path,
+    plan: &CampaignPlan,
+    shard: Option<(usize, usize)>,
+) -> Result<(), String> {
+    write_json(
+        &out.join(CAMPAIGN_FILE),
+        &campaign_file(&plan.to_value(), shard),
+    )
+}
+
 #[cfg(test)]
 mod tests {
     use super::first_difference;

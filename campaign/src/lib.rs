@@ -38,6 +38,14 @@
 //! n = [3, 3]
 //! split = "train"                  # or "test"
 //! prefix = "R"                     # names R01, R02, ... (cranial row first, then by x)
+//! [[locations.design]]             # optional space-filling designs (module `design`)
+//! kind = "sobol"                   # or "lhs" (Latin hypercube), "random" (uniform)
+//! n = 50
+//! seed = 1
+//! split = "train"                  # or "test"
+//! prefix = "S"                     # names S01, S02, ... (default S sobol, L lhs, U random)
+//! # extent = [["-100 mm", "165 mm"], ["0 mm", "225 mm"]]   # the default: the ROI's plan extent
+//! # polygon = [["-100 mm", "165 mm"], ["0 mm", "165 mm"], ["-50 mm", "225 mm"]]   # not lhs
 //!
 //! [indentation]
 //! depth = "15 mm"                  # one value or a list: every depth is run
@@ -66,10 +74,13 @@
 //! `<location>_d<depth>mm_t<duration>ms` when the campaign has more than one depth or duration.
 //! Run `k` (0-based, in this order) belongs to shard `k mod n` ([`in_shard`]).
 
+mod adaptive;
 mod assemble;
+mod design;
 mod dir;
 mod execute;
 mod json_file;
+mod label;
 mod merge;
 mod outcome;
 mod phantom_record;
@@ -78,8 +89,16 @@ mod run_files;
 mod shard;
 mod spec;
 
+pub use adaptive::{
+    check_adaptive, extend, next_batch, AdaptiveBatch, AdaptivePoint, AdaptiveRecord,
+    ADAPTIVE_FILE, CANDIDATES, CANDIDATE_SEED, FORCE_POINTS,
+};
 pub use assemble::{assemble, write_dataset};
-pub use dir::{campaign_file, first_difference, prepare_dir, read_campaign_dir, CampaignDir};
+pub use design::{default_extent, DesignKind, DesignSpec, Region, MAX_DESIGN_POINTS};
+pub use dir::{
+    campaign_file, first_difference, prepare_dir, read_campaign_dir, write_campaign_file,
+    CampaignDir,
+};
 pub use execute::{execute, run_one, Parallelism, Report, RunEvent};
 pub use json_file::{read_json, write_json};
 pub use merge::{merge, MergeReport};

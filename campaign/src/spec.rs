@@ -1,6 +1,8 @@
 //! The campaign file ([`CampaignSpec`]; the format is in the crate doc) and its resolution into
 //! a [`Campaign`]: locations in order, each train or test, and the runs.
 
+use crate::design::DesignSpec;
+use crate::label::check_label;
 use crate::plan::{Campaign, CampaignLocation, PlannedRun, Split};
 use material::quantity::{Length, Number, Time, Velocity};
 use phantom::PAPER_VOXEL;
@@ -99,6 +101,9 @@ pub struct LocationsSpec {
     /// Further rasters of points.
     #[serde(default)]
     pub raster: Vec<RasterSpec>,
+    /// Space-filling designs (Sobol, Latin hypercube or seeded uniform random).
+    #[serde(default)]
+    pub design: Vec<DesignSpec>,
 }
 
 /// `[indentation]`.
@@ -173,20 +178,6 @@ fn short(v: f64, d: usize) -> String {
     } else {
         s
     }
-}
-
-fn check_label(l: &str) -> Result<(), String> {
-    if l.is_empty()
-        || !l
-            .chars()
-            .all(|c| c.is_ascii_alphanumeric() || matches!(c, '-' | '_' | '.'))
-        || l.starts_with('.')
-    {
-        return Err(format!(
-            "location label `{l}`: use letters, digits, `-`, `_` and `.` (it names a directory)"
-        ));
-    }
-    Ok(())
 }
 
 fn entry_locations(e: &LocationEntry, split: Split) -> Result<Vec<CampaignLocation>, String> {
@@ -486,7 +477,8 @@ fn indentation(
     Ok((depths, timing, max_samples))
 }
 
-/// `[locations]`: train entries, train rasters, test entries, test rasters, each label once.
+/// `[locations]`: train entries, train rasters, train designs, then the same for test, each
+/// label once.
 fn resolve_locations(l: &LocationsSpec) -> Result<Vec<CampaignLocation>, String> {
     let default_train = vec![LocationEntry::Name("grid".into())];
     let default_test: Vec<LocationEntry> = ["A", "B", "C"]
@@ -499,6 +491,15 @@ fn resolve_locations(l: &LocationsSpec) -> Result<Vec<CampaignLocation>, String>
         .iter()
         .map(raster_locations)
         .collect::<Result<_, _>>()?;
+    let designs: Vec<Vec<CampaignLocation>> = l
+        .design
+        .iter()
+        .enumerate()
+        .map(|(k, d)| {
+            d.locations()
+                .map_err(|e| format!("[[locations.design]] number {}: {e}", k + 1))
+        })
+        .collect::<Result<_, _>>()?;
     for (split, entries) in [
         (Split::Train, l.train.as_ref().unwrap_or(&default_train)),
         (Split::Test, l.test.as_ref().unwrap_or(&default_test)),
@@ -509,6 +510,11 @@ fn resolve_locations(l: &LocationsSpec) -> Result<Vec<CampaignLocation>, String>
         for (s, r) in &rasters {
             if *s == split {
                 locations.extend(r.iter().cloned());
+            }
+        }
+        for (d, pts) in l.design.iter().zip(&designs) {
+            if d.split == split {
+                locations.extend(pts.iter().cloned());
             }
         }
     }
