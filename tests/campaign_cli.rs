@@ -18,41 +18,16 @@
 //!   and a bad key is an error naming it.
 
 use std::path::Path;
-use std::process::{Command, Output, Stdio};
+use std::process::{Command, Stdio};
 use std::time::{Duration, Instant};
 use surrogate::{Dataset, ViewGeometry};
 
+#[path = "support/cli.rs"]
+mod cli;
+use cli::{ok, palpa, s};
 #[path = "support/tiny_campaign.rs"]
 mod tiny_campaign;
 use tiny_campaign::{done_count, tiny, RUNS, SAMPLES, TINY};
-
-fn palpa(args: &[&str]) -> Output {
-    let out = Command::new(env!("CARGO_BIN_EXE_palpa"))
-        .args(args)
-        .output()
-        .unwrap();
-    assert!(
-        !String::from_utf8_lossy(&out.stderr).contains("panicked"),
-        "panic: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    out
-}
-
-fn ok(args: &[&str]) -> String {
-    let o = palpa(args);
-    let stdout = String::from_utf8_lossy(&o.stdout).into_owned();
-    assert!(
-        o.status.success(),
-        "palpa {args:?} failed: {}\n{stdout}",
-        String::from_utf8_lossy(&o.stderr)
-    );
-    stdout
-}
-
-fn s(p: &Path) -> &str {
-    p.to_str().unwrap()
-}
 
 /// The dataset has RUNS x SAMPLES rows in run order: locations 0, 1, 2, splits train, train,
 /// test, times 0, 0.5, 1 ms within each run; no row lost or duplicated.
@@ -397,7 +372,25 @@ fn shipped_profiles_resolve_and_bad_keys_are_named() {
             "{err}"
         );
     };
+    // the Sobol front's profile: 100 design points S001..S100 in the ROI's plan extent,
+    // A, B, C and 12 random held-out points T01..T12
+    let sobol = dry_run("campaign-sobol-5mm.toml");
+    assert!(
+        sobol.contains("115 runs (115 locations: 100 train, 15 test)"),
+        "{sobol}"
+    );
+    let sx = ys(&sobol, 'S');
+    assert_eq!(sx.len(), 100, "{sobol}");
+    assert!(sx.iter().all(|y| (165.0..=225.0).contains(y)), "{sx:?}");
     fails_naming("[indentation]\ndepht = \"5 mm\"\n", "depht");
+    fails_naming(
+        "[[locations.design]]\nkind = \"halton\"\nn = 4\nseed = 1\nsplit = \"train\"\n",
+        "halton",
+    );
+    fails_naming(
+        "[[locations.design]]\nkind = \"lhs\"\nn = 4\nseed = 1\nsplit = \"train\"\npolygon = [[\"0 mm\", \"0 mm\"], [\"1 mm\", \"0 mm\"], [\"0 mm\", \"1 mm\"]]\n",
+        "polygon",
+    );
     // a value out of range names the file and the key
     fails_naming("[phantom]\nfat_thickness = \"-5 mm\"\n", "fat_thickness");
     let o = palpa(&["campaign", "--shard", "2/2", "--dry-run"]);

@@ -27,8 +27,8 @@
 
 use super::progress::{stop_flag, time_bar};
 use campaign::{
-    read_done, resolve_shard, run_dir, Campaign, CampaignSpec, Outcome, Parallelism, PlannedRun,
-    Report, RunEvent, Split,
+    read_done, resolve_shard, run_dir, AdaptiveRecord, Campaign, CampaignSpec, Outcome,
+    Parallelism, PlannedRun, Report, RunEvent, Split,
 };
 use phantom::Phantom;
 use std::path::{Path, PathBuf};
@@ -73,6 +73,15 @@ pub struct CampaignArgs {
     /// Build the phantom, check the locations, print the plan; run nothing.
     #[arg(long)]
     dry_run: bool,
+    /// After the campaign's own runs, add N training runs in batches where the current GP is
+    /// least sure (its variance averaged over forces), retraining between batches; the
+    /// batches are recorded in adaptive.json and the plan (docs/campaigns.md, adaptive
+    /// sampling). Resume a stopped one with the same flags and --resume.
+    #[arg(long, value_name = "N")]
+    adaptive: Option<usize>,
+    /// Runs per adaptive batch.
+    #[arg(long, value_name = "B", default_value_t = 10, requires = "adaptive")]
+    batch: usize,
     /// Stop after starting this many runs (for tests of --resume).
     #[arg(long, hide = true)]
     max_runs: Option<usize>,
@@ -123,11 +132,15 @@ fn run_campaign(a: &CampaignArgs) -> Result<(), String> {
         Some(f) => format!("{}: {e}", f.display()),
         None => e,
     };
-    let campaign = spec.resolve().map_err(in_file)?;
+    let mut campaign = spec.resolve().map_err(in_file)?;
     let shard = resolve_shard(a.shard.as_deref(), &a.out)?;
     if a.jobs == Some(0) || a.threads == Some(0) {
         return Err("--jobs and --threads must be at least 1".into());
     }
+    let record = AdaptiveRecord::read(&a.out)?;
+    let candidates = adaptive_setup(a, &spec, &campaign, &record, shard, &in_file)?;
+    campaign::extend(&mut campaign, &record.batches)
+        .map_err(|e| format!("{}: {e}", a.out.display()))?;
 
     // The phantom, once for every run.
     let t0 = Instant::now();
@@ -152,6 +165,21 @@ fn run_campaign(a: &CampaignArgs) -> Result<(), String> {
         return Ok(());
     }
 
+    // an adaptive campaign stopped between writing a batch to adaptive.json and to
+    // campaign.json: the plan there lacks the last batch
+    if let (Some(_), Some(last)) = (a.adaptive, record.batches.last()) {
+        let mut before = campaign.clone();
+        let keep = before.runs.len() - last.points.len();
+        before.runs.truncate(keep);
+        before
+            .locations
+            .truncate(before.locations.len() - last.points.len());
+        let there = campaign::read_campaign_dir(out).ok();
+        let before_plan = before.plan(&phantom, &locs[..before.locations.len()]);
+        if there.is_some_and(|d| d.plan_value == before_plan.to_value()) {
+            campaign::write_campaign_file(out, &plan, None)?;
+        }
+    }
     // campaign.json: a resumed campaign must be the same campaign.
     campaign::prepare_dir(out, &plan, shard, n_done, a.resume, &mut |v| {
         if !a.quiet {
@@ -176,13 +204,167 @@ fn run_campaign(a: &CampaignArgs) -> Result<(), String> {
     view.write(&vpath)
         .map_err(|e| format!("{}: {e}", vpath.display()))?;
 
-    let todo: Vec<&PlannedRun> = mine
+    let todo: Vec<PlannedRun> = mine
         .iter()
         .zip(&done)
         .filter(|(_, &d)| !d)
-        .map(|(r, _)| *r)
-        .take(a.max_runs.unwrap_or(usize::MAX))
+        .map(|(r, _)| (*r).clone())
         .collect();
+    let mut state = Invocation {
+        plan,
+        record,
+        candidates,
+        n_done,
+        budget: a.max_runs.unwrap_or(usize::MAX),
+    };
+    run_and_grow(a, &mut campaign, &phantom, &mut state, todo, shard, t_start)
+}
+
+/// With `--adaptive`: checks that the campaign can grow and builds the batches' candidate
+/// locations. Without it: refuses a directory that holds adaptive batches.
+fn adaptive_setup(
+    a: &CampaignArgs,
+    spec: &CampaignSpec,
+    campaign: &Campaign,
+    record: &AdaptiveRecord,
+    shard: Option<(usize, usize)>,
+    in_file: &dyn Fn(String) -> String,
+) -> Result<Option<Vec<[f64; 2]>>, String> {
+    match a.adaptive {
+        Some(n) => {
+            if shard.is_some() {
+                return Err(
+                    "--adaptive chooses each batch from all the runs before it: it does not shard"
+                        .into(),
+                );
+            }
+            if a.batch == 0 {
+                return Err("--batch must be at least 1".into());
+            }
+            campaign::check_adaptive(campaign, n).map_err(in_file)?;
+            Ok(Some(adaptive_candidates(spec).map_err(in_file)?))
+        }
+        None if !record.batches.is_empty() => Err(format!(
+                "{} holds an adaptive campaign ({} batches in {}): continue it with --adaptive N --resume",
+                a.out.display(),
+                record.batches.len(),
+            a.out.join(campaign::ADAPTIVE_FILE).display()
+        )),
+        None => Ok(None),
+    }
+}
+
+/// What changes as an adaptive campaign grows.
+struct Invocation {
+    plan: campaign::CampaignPlan,
+    record: AdaptiveRecord,
+    /// Candidate locations of adaptive batches (`None` without `--adaptive`).
+    candidates: Option<Vec<[f64; 2]>>,
+    n_done: usize,
+    /// Runs this invocation may still start (`--max-runs`).
+    budget: usize,
+}
+
+/// Candidate locations of adaptive batches: Sobol points in the region of the campaign's first
+/// training design, or the ROI's plan extent.
+fn adaptive_candidates(spec: &CampaignSpec) -> Result<Vec<[f64; 2]>, String> {
+    let region = match spec
+        .locations
+        .design
+        .iter()
+        .find(|d| d.split == Split::Train)
+    {
+        Some(d) => d.region()?,
+        None => campaign::Region::Rect(campaign::default_extent()),
+    };
+    region.sobol(campaign::CANDIDATES, campaign::CANDIDATE_SEED)
+}
+
+/// Run `todo`, write the dataset when every run is finished, and with `--adaptive` choose the
+/// next batch, record it, and go on until the adaptive runs are in.
+fn run_and_grow(
+    a: &CampaignArgs,
+    campaign: &mut Campaign,
+    phantom: &Phantom,
+    st: &mut Invocation,
+    mut todo: Vec<PlannedRun>,
+    shard: Option<(usize, usize)>,
+    t_start: Instant,
+) -> Result<(), String> {
+    let out = &a.out;
+    loop {
+        let ran = run_todo(a, campaign, phantom, st, &todo, shard, t_start)?;
+        let Some(ds) = ran else {
+            return Ok(());
+        };
+        let (Some(n_adaptive), Some(candidates)) = (a.adaptive, &st.candidates) else {
+            return Ok(());
+        };
+        let have = st.record.n_points();
+        if have >= n_adaptive {
+            return Ok(());
+        }
+        let size = a.batch.min(n_adaptive - have);
+        let number = st.record.batches.len() + 1;
+        let t0 = Instant::now();
+        let over_skin = |x: f64, y: f64| {
+            phantom::location_at(
+                &phantom.mesh,
+                &phantom.skin_faces,
+                &phantom.volume,
+                "c",
+                x,
+                y,
+            )
+            .is_ok()
+        };
+        let batch = campaign::next_batch(&ds, candidates, number, size, &over_skin)?;
+        if !a.quiet {
+            println!(
+                "  adaptive batch {number}: {size} location(s) chosen in {:.1} s by the GP on {} training locations (held-out Fit {}, 95 % coverage {}); largest force-averaged variance {:.3e} Pa^2",
+                t0.elapsed().as_secs_f64(),
+                batch.trained_on_locations,
+                batch.test_fit.map_or("-".into(), |f| format!("{f:.4}")),
+                batch.test_coverage_95.map_or("-".into(), |c| format!("{:.1} %", 100.0 * c)),
+                batch.max_variance
+            );
+            for p in &batch.points {
+                println!(
+                    "    {} at x = {:.1} mm, y = {:.1} mm (variance {:.3e} Pa^2)",
+                    p.label,
+                    p.at[0] * 1e3,
+                    p.at[1] * 1e3,
+                    p.variance
+                );
+            }
+        }
+        st.record.batches.push(batch.clone());
+        st.record.write(out)?;
+        let first_new = campaign.runs.len();
+        campaign::extend(campaign, std::slice::from_ref(&batch))?;
+        let locs = campaign.resolve_locations(phantom)?;
+        st.plan = campaign.plan(phantom, &locs);
+        campaign::write_campaign_file(out, &st.plan, None)?;
+        todo = campaign.runs[first_new..].to_vec();
+    }
+}
+
+/// Run `todo` (a share of the campaign's runs) and write the dataset when every run of the
+/// campaign or shard is finished; `None` when some are not.
+fn run_todo(
+    a: &CampaignArgs,
+    campaign: &Campaign,
+    phantom: &Phantom,
+    st: &mut Invocation,
+    todo: &[PlannedRun],
+    shard: Option<(usize, usize)>,
+    t_start: Instant,
+) -> Result<Option<Dataset>, String> {
+    let out = &a.out;
+    let todo: Vec<&PlannedRun> = todo.iter().take(st.budget).collect();
+    st.budget -= todo.len();
+    let mine = campaign.runs_of(shard);
+    let n_done = st.n_done;
     let Parallelism { jobs, threads } = Parallelism::choose(a.jobs, a.threads, todo.len(), cores());
     if !a.quiet {
         println!(
@@ -195,7 +377,8 @@ fn run_campaign(a: &CampaignArgs) -> Result<(), String> {
         );
     }
 
-    let report = execute_with_progress(&campaign, &todo, out, &phantom, jobs, threads, a.quiet)?;
+    let report = execute_with_progress(campaign, &todo, out, phantom, jobs, threads, a.quiet)?;
+    st.n_done += report.finished;
     if !a.quiet {
         println!(
             "  {} run(s) finished in this invocation, {} failed{}; wall time {:.1} s (run time {:.1} s)",
@@ -206,7 +389,7 @@ fn run_campaign(a: &CampaignArgs) -> Result<(), String> {
             report.run_seconds
         );
     }
-    match campaign::finish(&a.out, &report, &plan, &mine)? {
+    match campaign::finish(&a.out, &report, &st.plan, &mine)? {
         Outcome::Unfinished(missing) => {
             println!(
                 "  {} run(s) not finished ({}); continue with --resume",
@@ -216,14 +399,15 @@ fn run_campaign(a: &CampaignArgs) -> Result<(), String> {
             if report.stopped {
                 return Err("stopped".into());
             }
+            Ok(None)
         }
         Outcome::Dataset(ds) => {
             if !a.quiet {
                 print_dataset(&ds, &a.out, shard.is_some());
             }
+            Ok(Some(ds))
         }
     }
-    Ok(())
 }
 
 /// The campaign's first line: runs, locations, shard, phantom and its build time.

@@ -6,6 +6,7 @@ mod campaign;
 mod check;
 mod evaluate;
 mod export;
+mod front;
 mod input;
 mod material;
 mod mesh;
@@ -14,6 +15,7 @@ mod predict;
 mod predict_line;
 mod progress;
 mod run;
+mod selection;
 mod study;
 mod train;
 mod units;
@@ -139,6 +141,9 @@ enum Command {
     /// Leave-one-location-out cross-validation of each surrogate type and size, and the
     /// accuracy-versus-cost table (Fit, training time, prediction latency).
     Evaluate(evaluate::EvaluateArgs),
+    /// The accuracy-per-run front of surrogate designs: the GP trained on each campaign's
+    /// first n training runs, held-out Fit and interval coverage against n and core-hours.
+    Front(front::FrontArgs),
     /// Whole-run throughput: element-cycles per second of 100k-element blocks (neo-Hookean
     /// one-point and F-bar, the two-finger press on the paper's flesh with the contact
     /// stage's share, and the paper's liver), with the memory roof, on each thread count.
@@ -222,6 +227,7 @@ pub fn dispatch(cli: Cli) -> Result<(), String> {
         Command::Serve(a) => crate::serve::serve(&a),
         Command::Calibrate(a) => calibrate::calibrate(&a),
         Command::Evaluate(a) => evaluate::run(&a),
+        Command::Front(a) => front::run(&a),
         Command::Bench {
             cases,
             threads,

@@ -100,6 +100,12 @@ pub struct TrainArgs {
     /// [default: 1e-4]; 0 keeps every output direction, the exact posterior mean.
     #[arg(long)]
     pub output_tolerance: Option<f64>,
+    /// Train on the first N training locations only, in the dataset's (the campaign's) order:
+    /// the first N points of a Sobol design are themselves a design [default: all].
+    #[arg(long, value_name = "N")]
+    pub train_locations: Option<usize>,
+    #[command(flatten)]
+    pub sample_target: super::selection::SampleTargetArgs,
     /// Worker threads of the global pool [default: all cores]. The trainers themselves run on
     /// one thread, so that a seed gives the same model on any machine.
     #[arg(long)]
@@ -199,7 +205,20 @@ pub fn train(a: &TrainArgs) -> Result<(), String> {
         "palpa train: {what}, {target} target, on {} ...",
         a.dataset.display()
     );
-    let report = surrogate::train(&a.dataset, kind, &opts, &a.out)
+    let interval = a.sample_target.interval()?;
+    if a.train_locations == Some(0) {
+        return Err("--train-locations must be at least 1".into());
+    }
+    let recovery_width = a.sample_target.recovery_width()?;
+    if recovery_width.is_some() && matches!(a.target, Some(TargetArg::Tensor)) {
+        return Err("--recover averages the principal stress: it takes no --target tensor".into());
+    }
+    let selection = surrogate::TrainingSelection {
+        first_locations: a.train_locations,
+        interval,
+        recovery_width,
+    };
+    let report = surrogate::train_selected(&a.dataset, &selection, kind, &opts, &a.out)
         .map_err(|e| format!("train {}: {e}", a.dataset.display()))?;
     println!("Fit = 1 - sqrt(SSE / SST), paper eq. 5 (1 perfect, 0 no better than the mean)");
     println!("{report}");

@@ -1,0 +1,271 @@
+//! `palpa front NAME=DIR[:N,..]... --runs 10,25,50,100 --out DIR`: the accuracy-per-run front of
+//! surrogate designs. For each campaign directory (a design: the paper's raster, a Sobol
+//! design, an adaptive one) and each run count n, the default GP (`palpa train --model gp`)
+//! trains on the campaign's first n training locations (the campaign's order: the first n
+//! points of a Sobol design, the initial design then the adaptive batches in the order they
+//! were chosen) and is scored on every held-out location of that campaign. n counts
+//! locations: in a campaign with several depths or durations every run of a location counts in
+//! the cost.
+//!
+//! Reported per row: held-out Fit (paper eq. 5) pooled over all test locations, over A, B and
+//! C, and over the other test locations (the seeded random ones); the Fit at the paper's time
+//! stamps; the GP's 95 % interval coverage; the training runs' solver cost (their run wall
+//! time times their threads, from each run's `done.json`, in core-hours) and the training
+//! time. `--recover H` trains and scores on the recovered stress target
+//! ([`surrogate::recovery`]) instead of the element stress. Written as `front.csv`, `front.md` and `front.png` (Fit against runs, one line per
+//! design), each atomically.
+
+use super::train::check_dataset_path;
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+use surrogate::{Dataset, ModelKind, Split, TrainOptions};
+
+/// `palpa front`'s arguments.
+#[derive(clap::Args)]
+pub struct FrontArgs {
+    /// Designs as NAME=DIR: campaign directories holding dataset.npz and runs/; NAME=DIR:N,N
+    /// gives that design its own run counts (e.g. grid=DIR:25, the paper's whole raster).
+    #[arg(required = true, value_name = "NAME=DIR[:N,...]")]
+    pub designs: Vec<String>,
+    /// Training run counts (each at most a design's training locations; larger ones are
+    /// skipped for that design).
+    #[arg(long, value_delimiter = ',', default_value = "25,50,100")]
+    pub runs: Vec<usize>,
+    #[command(flatten)]
+    pub target: super::selection::SampleTargetArgs,
+    /// Where to write front.csv, front.md and front.png.
+    #[arg(long)]
+    pub out: PathBuf,
+}
+
+/// One point of the front.
+struct Row {
+    design: String,
+    runs: usize,
+    core_hours: f64,
+    fit_all: f64,
+    fit_abc: Option<f64>,
+    fit_other: Option<f64>,
+    fit_paper_times: f64,
+    coverage: Option<f64>,
+    train_seconds: f64,
+}
+
+impl Row {
+    /// The row's cells as `front.csv` (`md` false) or `front.md` (coverage in %, fewer digits)
+    /// writes them.
+    fn cells(&self, md: bool) -> [String; 9] {
+        let o = |v: Option<f64>| v.map_or(String::new(), |f| format!("{f:.4}"));
+        let coverage = if md {
+            self.coverage
+                .map_or("-".into(), |c| format!("{:.1} %", 100.0 * c))
+        } else {
+            o(self.coverage)
+        };
+        [
+            self.design.clone(),
+            self.runs.to_string(),
+            if md {
+                format!("{:.3}", self.core_hours)
+            } else {
+                format!("{:.4}", self.core_hours)
+            },
+            format!("{:.4}", self.fit_all),
+            o(self.fit_abc),
+            o(self.fit_other),
+            format!("{:.4}", self.fit_paper_times),
+            coverage,
+            if md {
+                format!("{:.1}", self.train_seconds)
+            } else {
+                format!("{:.2}", self.train_seconds)
+            },
+        ]
+    }
+}
+
+/// Run `palpa front`.
+pub fn run(a: &FrontArgs) -> Result<(), String> {
+    let (interval, recovery_width) = (a.target.interval()?, a.target.recovery_width()?);
+    if a.runs.contains(&0) {
+        return Err("--runs: counts must be at least 1".into());
+    }
+    let mut designs: Vec<(String, PathBuf, Vec<usize>)> = Vec::new();
+    for d in &a.designs {
+        let (name, dir, runs) = parse_design(d, &a.runs)?;
+        if designs.iter().any(|x| x.0 == name) {
+            return Err(format!("design `{name}` is named twice"));
+        }
+        check_dataset_path(&dir)?;
+        designs.push((name, dir, runs));
+    }
+    std::fs::create_dir_all(&a.out)
+        .map_err(|e| format!("{}: cannot create: {e}", a.out.display()))?;
+    let mut rows = Vec::new();
+    for (name, dir, runs) in &designs {
+        let data = Dataset::read(dir).map_err(|e| format!("dataset {}: {e}", dir.display()))?;
+        let order = data.training_location_order();
+        for &n in runs {
+            if n > order.len() {
+                eprintln!(
+                    "  {name}: {n} runs skipped (the campaign has {} training locations)",
+                    order.len()
+                );
+                continue;
+            }
+            let selection = surrogate::TrainingSelection {
+                first_locations: Some(n),
+                interval,
+                recovery_width,
+            };
+            let row = point(name, dir, &data, &order[..n], &selection)?;
+            println!(
+                "  {name:<10} {n:>4} runs, {:.3} core-h: held-out Fit {:.4} (A, B, C {}, others {}), at the paper's stamps {:.4}, 95 % coverage {}, trained in {:.1} s",
+                row.core_hours,
+                row.fit_all,
+                opt(row.fit_abc),
+                opt(row.fit_other),
+                row.fit_paper_times,
+                row.coverage.map_or("-".into(), |c| format!("{:.1} %", 100.0 * c)),
+                row.train_seconds
+            );
+            rows.push(row);
+        }
+    }
+    write_outputs(&a.out, &rows)
+}
+
+/// `NAME=DIR` or `NAME=DIR:N,N` (the design's own run counts; a DIR ending in `:digits` is
+/// read as a count list).
+fn parse_design(d: &str, runs: &[usize]) -> Result<(String, PathBuf, Vec<usize>), String> {
+    let (name, rest) = d
+        .split_once('=')
+        .filter(|(n, r)| !n.is_empty() && !r.is_empty())
+        .ok_or_else(|| format!("design `{d}`: give NAME=DIR or NAME=DIR:N,N"))?;
+    let counts = rest
+        .rsplit_once(':')
+        .filter(|(_, l)| !l.is_empty() && l.chars().all(|c| c.is_ascii_digit() || c == ','));
+    let (dir, runs) = match counts {
+        Some((dir, list)) => {
+            let n: Vec<usize> = list
+                .split(',')
+                .map(|n| n.parse::<usize>().ok().filter(|&n| n > 0))
+                .collect::<Option<_>>()
+                .ok_or_else(|| {
+                    format!(
+                        "design `{d}`: the run counts after `:` must be positive, comma-separated"
+                    )
+                })?;
+            (dir, n)
+        }
+        None => (rest, runs.to_vec()),
+    };
+    Ok((name.to_string(), PathBuf::from(dir), runs))
+}
+
+fn opt(v: Option<f64>) -> String {
+    v.map_or("-".into(), |f| format!("{f:.4}"))
+}
+
+/// Train on `locs` (and `interval`), score the test rows.
+fn point(
+    name: &str,
+    dir: &Path,
+    data: &Dataset,
+    locs: &[i64],
+    selection: &surrogate::TrainingSelection,
+) -> Result<Row, String> {
+    let sel = selection
+        .apply(data)
+        .map_err(|e| format!("{name} ({}): {e}", dir.display()))?;
+    if sel.rows_with_split(Split::Test).is_empty() {
+        return Err(format!(
+            "{name} ({}): the campaign has no held-out (test) locations to score",
+            dir.display()
+        ));
+    }
+    let (_, report, yhat) =
+        surrogate::train_and_predict(&sel, ModelKind::Gp, &TrainOptions::default())
+            .map_err(|e| format!("{name}: {e}"))?;
+    let (abc, other): (Vec<usize>, Vec<usize>) = sel
+        .rows_with_split(Split::Test)
+        .into_iter()
+        .partition(|&i| ["A", "B", "C"].contains(&sel.location_label(sel.location[i]).as_str()));
+    let score = |rows: &[usize]| {
+        (!rows.is_empty()).then(|| {
+            let pick = |a: &ndarray::Array2<f64>| a.select(ndarray::Axis(0), rows);
+            surrogate::compute_fit(pick(&sel.y).view(), pick(&yhat).view())
+        })
+    };
+    let (fit_abc, fit_other) = (score(&abc), score(&other));
+    let seconds = training_seconds(dir, &sel, locs)?;
+    Ok(Row {
+        design: name.to_string(),
+        runs: locs.len(),
+        core_hours: seconds / 3600.0,
+        fit_all: report.test_fit.unwrap_or(f64::NAN),
+        fit_abc,
+        fit_other,
+        fit_paper_times: report
+            .test_fit_paper_times
+            .or(report.test_fit)
+            .unwrap_or(f64::NAN),
+        coverage: report.test_coverage_95,
+        train_seconds: report.train_seconds,
+    })
+}
+
+/// Core-seconds of the runs at the training locations `locs` (every run of each location, from
+/// the plan in `campaign.json`): run wall time times threads, from each `done.json`.
+fn training_seconds(dir: &Path, data: &Dataset, locs: &[i64]) -> Result<f64, String> {
+    let plan = campaign::read_campaign_dir(dir)?.plan()?;
+    let labels: Vec<String> = locs.iter().map(|&l| data.location_label(l)).collect();
+    let mut seconds = 0.0;
+    for r in plan.runs.iter().filter(|r| labels.contains(&r.location)) {
+        let path = campaign::run_dir(dir, &r.label);
+        let m = campaign::read_done(&path)
+            .ok_or_else(|| format!("{}: no readable done.json", path.display()))?;
+        seconds += m.wall_seconds * m.threads as f64;
+    }
+    Ok(seconds)
+}
+
+fn write_outputs(out: &Path, rows: &[Row]) -> Result<(), String> {
+    let mut csv = String::from(
+        "design,runs,core_hours,fit_heldout,fit_abc,fit_other,fit_paper_times,coverage_95,train_seconds\n",
+    );
+    let mut md = String::from(
+        "| design | runs | solver core-h | held-out Fit | A, B, C | other held-out | at the paper's stamps | 95 % coverage | GP training (s) |\n|---|---:|---:|---:|---:|---:|---:|---:|---:|\n",
+    );
+    for r in rows {
+        let _ = writeln!(csv, "{}", r.cells(false).join(","));
+        let _ = writeln!(md, "| {} |", r.cells(true).join(" | "));
+    }
+    let write = |name: &str, text: &str| {
+        solver::output::atomic::write_atomic(&out.join(name), text.as_bytes())
+    };
+    write("front.csv", &csv)?;
+    write("front.md", &md)?;
+    let mut curves: Vec<(String, Vec<(f64, f64)>)> = Vec::new();
+    for r in rows {
+        match curves.iter_mut().find(|c| c.0 == r.design) {
+            Some(c) => c.1.push((r.runs as f64, r.fit_all)),
+            None => curves.push((r.design.clone(), vec![(r.runs as f64, r.fit_all)])),
+        }
+    }
+    let series = verification::Series {
+        plot: "front".into(),
+        title: "held-out Fit against training runs".into(),
+        axes: ("training runs".into(), "held-out Fit (paper eq. 5)".into()),
+        log: false,
+        curves,
+    };
+    verification::plot::draw(&series, out)?;
+    println!(
+        "wrote {}, {} and {}",
+        out.join("front.csv").display(),
+        out.join("front.md").display(),
+        out.join("front.png").display()
+    );
+    Ok(())
+}

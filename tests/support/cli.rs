@@ -1,0 +1,36 @@
+//! Running the real `palpa` binary from a test: its output, success, and no panic.
+#![allow(dead_code)]
+
+use std::path::Path;
+use std::process::{Command, Output};
+
+/// Run `palpa ARGS`; a panic in its stderr fails the test.
+pub fn palpa(args: &[&str]) -> Output {
+    let out = Command::new(env!("CARGO_BIN_EXE_palpa"))
+        .args(args)
+        .output()
+        .unwrap();
+    assert!(
+        !String::from_utf8_lossy(&out.stderr).contains("panicked"),
+        "panic: {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    out
+}
+
+/// Run `palpa ARGS` and return its stdout; failure fails the test.
+pub fn ok(args: &[&str]) -> String {
+    let o = palpa(args);
+    let stdout = String::from_utf8_lossy(&o.stdout).into_owned();
+    assert!(
+        o.status.success(),
+        "palpa {args:?} failed: {}\n{stdout}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    stdout
+}
+
+/// A path as a command-line argument.
+pub fn s(p: &Path) -> &str {
+    p.to_str().unwrap()
+}
