@@ -113,8 +113,27 @@ enum Command {
     /// and Pareto plots into --out.
     Study {
         /// The quick profile (coarse phantom, 6 mm in 6 ms): a few minutes on 2 cores.
-        #[arg(long)]
+        #[arg(long, conflicts_with = "paper")]
         quick: bool,
+        /// The study at the paper's resolution: 3 mm voxels, 25 mm of fat, A, B and C, every
+        /// knob against one F-bar reference (hours on 2 cores; resumable from the records in
+        /// --out; docs/study/README.md).
+        #[arg(long)]
+        paper: bool,
+        /// Locations of the --paper study, comma-separated (A, B, C).
+        #[arg(
+            long,
+            value_delimiter = ',',
+            default_value = "A,B,C",
+            requires = "paper"
+        )]
+        locations: Vec<String>,
+        /// Write the --paper report from the records already in --out; run nothing.
+        #[arg(long, requires = "paper")]
+        report_only: bool,
+        /// Print the --paper plan (settings, and which have a record) and run nothing.
+        #[arg(long, requires = "paper", conflicts_with = "report_only")]
+        dry_run: bool,
         /// Output directory.
         #[arg(long, default_value = "results/study")]
         out: PathBuf,
@@ -212,12 +231,21 @@ pub fn dispatch(cli: Cli) -> Result<(), String> {
         Command::Export(a) => export::export(&a),
         Command::Study {
             quick,
+            paper,
+            locations,
+            report_only,
+            dry_run,
             out,
             threads,
             quiet,
         } => {
             set_threads(threads)?;
-            study::study(quick, &out, quiet)
+            if paper {
+                let how = study::PaperMode::new(report_only, dry_run);
+                study::study_paper(&out, &locations, how, quiet)
+            } else {
+                study::study(quick, &out, quiet)
+            }
         }
         Command::Material { file, out } => material::material(&file, out.as_deref()),
         Command::Mesh { what } => mesh::mesh(what),

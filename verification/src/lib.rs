@@ -27,6 +27,9 @@ pub mod quasi;
 pub mod report;
 pub mod study;
 pub mod study_hertz;
+pub mod study_paper;
+pub mod study_paper_record;
+pub mod study_paper_report;
 pub mod study_row;
 
 pub use report::{Row, Status};

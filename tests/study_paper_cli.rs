@@ -1,0 +1,125 @@
+//! `palpa study --paper` through the real binary, on the committed records of the 3 mm study
+//! (`data/study-3mm/records`; the runs themselves take hours, docs/study/README.md):
+//! - `--dry-run` finds every committed record current: the plan and the scene writer still
+//!   produce the scenes those runs ran (a change to either makes the committed study stale, and
+//!   this test says so);
+//! - `--report-only` rebuilds the report from the records alone: one CSV row per record, the
+//!   reference exact against itself (force error 0, Fit 1), the base's errors as the committed
+//!   report states them, the Pareto plots;
+//! - bad flags and an empty directory get a clear error.
+
+use std::path::{Path, PathBuf};
+
+#[path = "support/cli.rs"]
+mod cli;
+use cli::{ok, palpa, s};
+
+fn committed() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("data/study-3mm")
+}
+
+/// The committed records' file names.
+fn records() -> Vec<String> {
+    let mut v: Vec<String> = std::fs::read_dir(committed().join("records"))
+        .unwrap()
+        .map(|e| e.unwrap().file_name().into_string().unwrap())
+        .filter(|n| n.ends_with(".json"))
+        .collect();
+    v.sort();
+    v
+}
+
+/// The locations with at least one committed record.
+fn locations() -> Vec<String> {
+    let mut l: Vec<String> = records()
+        .iter()
+        .map(|n| n.split('-').next().unwrap().to_string())
+        .collect();
+    l.dedup();
+    l
+}
+
+#[test]
+fn committed_records_are_current() {
+    let locs = locations();
+    assert!(!locs.is_empty(), "no committed study records");
+    let out = ok(&[
+        "study",
+        "--paper",
+        "--dry-run",
+        "--locations",
+        &locs.join(","),
+        "--out",
+        s(&committed()),
+    ]);
+    let recorded = out.lines().filter(|l| l.ends_with("(recorded)")).count();
+    assert_eq!(
+        recorded,
+        records().len(),
+        "every committed record must be the scene the plan runs now:\n{out}"
+    );
+    // 15 settings per location
+    assert_eq!(out.lines().count(), 15 * locs.len(), "{out}");
+}
+
+#[test]
+fn the_report_is_rebuilt_from_records_alone() {
+    let dir = tempfile::tempdir().unwrap();
+    std::fs::create_dir_all(dir.path().join("records")).unwrap();
+    for n in records() {
+        std::fs::copy(
+            committed().join("records").join(&n),
+            dir.path().join("records").join(&n),
+        )
+        .unwrap();
+    }
+    let locs = locations();
+    ok(&[
+        "study",
+        "--paper",
+        "--report-only",
+        "--locations",
+        &locs.join(","),
+        "--out",
+        s(dir.path()),
+    ]);
+    let csv = std::fs::read_to_string(dir.path().join("study-3mm.csv")).unwrap();
+    assert_eq!(csv.lines().count(), 1 + records().len());
+    let header: Vec<&str> = csv.lines().next().unwrap().split(',').collect();
+    let col = |name: &str| header.iter().position(|h| *h == name).unwrap();
+    for line in csv.lines().skip(1).filter(|l| l.contains(",reference,")) {
+        let f: Vec<&str> = line.split(',').collect();
+        assert_eq!(f[col("pooled_fit")].parse::<f64>().unwrap(), 1.0, "{line}");
+        assert_eq!(f[col("peak_force_error")].parse::<f64>().unwrap(), 0.0);
+    }
+    // the rebuilt report is the committed one
+    let committed_csv = std::fs::read_to_string(committed().join("study-3mm.csv")).unwrap();
+    assert_eq!(csv, committed_csv);
+    assert!(dir.path().join("pareto_3mm_force.png").exists());
+    assert!(dir.path().join("pareto_3mm_fit.png").exists());
+}
+
+#[test]
+fn bad_flags_and_empty_directories_are_named() {
+    let dir = tempfile::tempdir().unwrap();
+    let o = palpa(&[
+        "study",
+        "--paper",
+        "--locations",
+        "A,Q",
+        "--dry-run",
+        "--out",
+        s(dir.path()),
+    ]);
+    assert!(!o.status.success());
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(err.contains("unknown location `Q`"), "{err}");
+    let o = palpa(&["study", "--quick", "--paper"]);
+    assert!(!o.status.success());
+    let o = palpa(&["study", "--report-only"]);
+    assert!(!o.status.success(), "--report-only needs --paper");
+    let o = palpa(&["study", "--paper", "--report-only", "--out", s(dir.path())]);
+    assert!(!o.status.success());
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(err.contains("no study records"), "{err}");
+}

@@ -1,0 +1,263 @@
+//! The accuracy study at the paper's resolution: `palpa study --paper`.
+//!
+//! The quick study ([`crate::study`]) prices each knob on an 8 mm phantom, where the mesh error
+//! swamps the rest. This one runs where the campaign and `palpate --paper` run: 3 mm voxels,
+//! the campaign phantom (25 mm of subcutaneous fat), the paper's 15 mm in 25 ms, pressing at
+//! A, B and C.
+//!
+//! **Design.** Every setting changes one knob of a *base* setting and is measured against one
+//! *reference*:
+//!
+//! - base: the `fast` preset ([`scene::palpation::Fidelity::Fast`]): one-point elements with
+//!   physical hourglass stabilisation, K/G <= 5000, `f32` kernels, mass scaling to the initial
+//!   step (palpate's default), time-step factor 0.9, 3 mm voxels;
+//! - knobs: mesh (4 and 2.5 mm), element (the viscous one-point form palpate runs by default,
+//!   and F-bar), the K/G cap (the laws' own 5e4, 1e3, 5e2), mass scaling (off, 1.3x and 2x
+//!   the initial step), time-step factor (0.5, 0.75) and precision (`f64`);
+//! - reference: the most faithful setting affordable on 2 cores: fully integrated F-bar
+//!   elements, the laws' own bulk moduli, `f64`, 3 mm, time-step factor 0.9, and mass scaling
+//!   to the initial step (no element gets mass at the start, crushed elements get enough to
+//!   keep the initial step). Without that mass the crushed elements cut the step several
+//!   times over and the F-bar reference would take hours per location; what the mass costs in
+//!   accuracy is what the `mass scaling = off` setting measures against the base.
+//!
+//! **Errors**, each setting against the reference at the same location:
+//!
+//! - hand force at each ROI sample time t_k (5, 10, 15, 20 ms and the end), the hand force
+//!   history filtered by a centred 1 ms moving average ([`FORCE_FILTER`]) and read at t_k (at
+//!   the end, half a window before it, so that the window lies inside the run): the signed
+//!   relative error `(F - F_ref) / F_ref`;
+//! - ROI stress Fit per sample (the paper's eq. 5 on the maximum principal stress of the ROI
+//!   elements), `Fit = 1 - sqrt(sum (s_ref - s)^2 / sum (s_ref - mean s_ref)^2)`, and pooled over
+//!   the samples; on another mesh each reference ROI element is compared with the run's ROI
+//!   element whose centroid is nearest;
+//! - peak values: the filtered hand force's maximum and the ROI's largest maximum principal
+//!   stress over the samples, as relative errors.
+//!
+//! **Costs**: the run's wall time on the machine's cores (the time loop and its output),
+//! steps, element-cycles (elements x steps) and element-cycles per second.
+//!
+//! **Resuming.** Each run leaves a [`RunRecord`] (`records/<location>-<setting>.json`) with
+//! its scene, cost and the data the errors need; a record whose scene is the one the plan asks
+//! for is read instead of run again, so an interrupted study goes on where it stopped and the
+//! report can be rebuilt from committed records alone.
+
+use crate::study_paper_record::{RunRecord, Variant};
+use phantom::Phantom;
+use scene::palpation::{read_probe, ElementChoice, Fidelity, PalpationSetup, Place};
+use scene::run::{run_scene, RunStatus};
+use solver::element::precision::Precision;
+use solver::model::StepTarget;
+use solver::output::filter::{moving_average, moving_average_at, FORCE_FILTER};
+use solver::output::history::{column, read_history};
+use std::collections::HashMap;
+use std::path::{Path, PathBuf};
+use std::sync::atomic::AtomicBool;
+
+/// The locations of the study.
+pub const LOCATIONS: [&str; 3] = ["A", "B", "C"];
+
+/// Knob name of the reference row.
+pub const REFERENCE: &str = "reference";
+/// Knob name of the base row.
+pub const BASE: &str = "base";
+
+/// The base setting at a location: the `fast` preset at 3 mm on the campaign phantom.
+pub fn base_setup(location: &str) -> PalpationSetup {
+    let mut s = PalpationSetup {
+        voxel: 0.003,
+        fat_thickness: 0.025,
+        place: Place::Named(location.into()),
+        vtk: false,
+        fidelity: Fidelity::Fast,
+        title: format!("study at 3 mm, location {location}"),
+        ..Default::default()
+    };
+    Fidelity::Fast.apply(&mut s);
+    s
+}
+
+/// The settings of the study at one location: the reference first, then the base, then one
+/// change of one knob of the base per setting.
+pub fn plan(location: &str) -> Vec<Variant> {
+    let base = base_setup(location);
+    // A changed knob is no longer the preset.
+    let one = |f: &dyn Fn(&mut PalpationSetup)| {
+        let mut s = base.clone();
+        s.fidelity = Fidelity::Standard;
+        f(&mut s);
+        s
+    };
+    let mut v = vec![
+        Variant::new(
+            REFERENCE,
+            "F-bar, laws' K, f64, mass scaling to the initial step",
+            one(&|s| {
+                s.element = ElementChoice::FullFbar;
+                s.max_bulk_ratio = None;
+                s.precision = Precision::F64;
+            }),
+        ),
+        Variant::new(
+            BASE,
+            "fast preset (1pt-physical, K/G <= 5000, f32, 3 mm)",
+            base.clone(),
+        ),
+    ];
+    for (mm, h) in [("4", 0.004), ("2.5", 0.0025)] {
+        v.push(Variant::new(
+            "mesh",
+            &format!("voxel {mm} mm"),
+            one(&|s| s.voxel = h),
+        ));
+    }
+    for el in [ElementChoice::OnePointViscousShear, ElementChoice::FullFbar] {
+        v.push(Variant::new(
+            "element",
+            el.label(),
+            one(&|s| s.element = el),
+        ));
+    }
+    v.push(Variant::new(
+        "bulk ratio",
+        "laws' own (K/G 5e4)",
+        one(&|s| s.max_bulk_ratio = None),
+    ));
+    for r in [1e3, 5e2] {
+        v.push(Variant::new(
+            "bulk ratio",
+            &format!("K/G <= {r}"),
+            one(&|s| s.max_bulk_ratio = Some(r)),
+        ));
+    }
+    v.push(Variant::new(
+        "mass scaling",
+        "off",
+        one(&|s| s.mass_scaling = None),
+    ));
+    for k in [1.3, 2.0] {
+        v.push(Variant::new(
+            "mass scaling",
+            &format!("{k} x initial step"),
+            one(&|s| {
+                s.mass_scaling = Some(StepTarget::Initial(k));
+                s.mass_scaling_limit = 1e3;
+            }),
+        ));
+    }
+    for f in [0.5, 0.75] {
+        v.push(Variant::new(
+            "dt factor",
+            &format!("{f}"),
+            one(&|s| s.dt_factor = f),
+        ));
+    }
+    v.push(Variant::new(
+        "precision",
+        "f64",
+        one(&|s| s.precision = Precision::F64),
+    ));
+    v
+}
+
+/// Where a setting's record lives.
+pub fn record_path(out: &Path, location: &str, va: &Variant) -> PathBuf {
+    out.join("records")
+        .join(format!("{location}-{}.json", va.slug()))
+}
+
+/// Run one setting (or read its record) at one location.
+fn run_or_read(
+    out: &Path,
+    location: &str,
+    va: &Variant,
+    phantoms: &mut HashMap<u64, Phantom>,
+) -> Result<RunRecord, String> {
+    let path = record_path(out, location, va);
+    let scene = va.setup.scene_toml();
+    if let Some(r) = RunRecord::read_if_current(&path, &scene)? {
+        return Ok(r);
+    }
+    let dir = out.join("runs").join(location).join(va.slug());
+    std::fs::create_dir_all(&dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+    let key = va.setup.voxel.to_bits();
+    if !phantoms.contains_key(&key) {
+        phantoms.insert(key, phantom::build(&va.setup.phantom_params()?)?);
+    }
+    let mut sc = va.setup.build_scene(&dir, phantoms.get(&key).cloned())?;
+    let centroids = sc
+        .phantom
+        .as_ref()
+        .map(|p| p.roi.centroids.clone())
+        .unwrap_or_default();
+    let stop = AtomicBool::new(false);
+    let (summary, err) = run_scene(&mut sc, &dir, &stop, |_| {});
+    let mut rec = RunRecord::from_summary(location, va, scene, &summary);
+    if let Some(e) = err {
+        rec.status = RunStatus::Failed(e).to_string();
+    } else {
+        let (cols, rows) = read_history(&dir.join("history.csv"))?;
+        let time = column(&cols, &rows, "time").ok_or("history without time")?;
+        let force = column(&cols, &rows, "hand_reaction").ok_or("history without hand_reaction")?;
+        let probe = read_probe(&dir, "hand")?;
+        let keep: Vec<usize> = (0..probe.time.len())
+            .filter(|&k| probe.time[k] > 0.0)
+            .collect();
+        rec.sample_times = keep.iter().map(|&k| probe.time[k]).collect();
+        let end = time.last().copied().unwrap_or(0.0);
+        let at: Vec<f64> = rec
+            .sample_times
+            .iter()
+            .map(|&t| t.min(end - 0.5 * FORCE_FILTER))
+            .collect();
+        rec.force_at_samples = moving_average_at(&time, &force, FORCE_FILTER, &at);
+        rec.peak_force = moving_average(&time, &force, FORCE_FILTER)
+            .into_iter()
+            .fold(0.0, f64::max);
+        rec.roi_centroids = centroids;
+        rec.roi_stress = keep.iter().map(|&k| probe.stress[k].clone()).collect();
+    }
+    rec.write(&path)?;
+    Ok(rec)
+}
+
+/// Run (or read) every setting at every location into `out`, in plan order (the reference,
+/// the dearest run, first at each location, so that every setting recorded after it can be
+/// compared at once); `progress` is told which setting starts. Returns the records.
+pub fn run(
+    out: &Path,
+    locations: &[String],
+    mut progress: impl FnMut(usize, usize, &str),
+) -> Result<Vec<RunRecord>, String> {
+    let mut phantoms = HashMap::new();
+    let plans: Vec<(String, Vec<Variant>)> =
+        locations.iter().map(|l| (l.clone(), plan(l))).collect();
+    let n: usize = plans.iter().map(|p| p.1.len()).sum();
+    let mut records = Vec::new();
+    for (loc, va) in plans
+        .iter()
+        .flat_map(|(l, v)| v.iter().map(move |va| (l, va)))
+    {
+        progress(
+            records.len(),
+            n,
+            &format!("{loc}: {} = {}", va.knob, va.setting),
+        );
+        records.push(run_or_read(out, loc, va, &mut phantoms)?);
+    }
+    Ok(records)
+}
+
+/// Read whatever records of the plan exist in `out` (for a report without runs).
+pub fn read_records(out: &Path, locations: &[String]) -> Result<Vec<RunRecord>, String> {
+    let mut records = Vec::new();
+    for loc in locations {
+        for va in plan(loc) {
+            let path = record_path(out, loc, &va);
+            if let Some(r) = RunRecord::read_if_current(&path, &va.setup.scene_toml())? {
+                records.push(r);
+            }
+        }
+    }
+    Ok(records)
+}

@@ -1,0 +1,427 @@
+//! What one setting of the paper-resolution study ([`crate::study_paper`]) is and what its run
+//! left behind ([`RunRecord`]), and its errors against the reference ([`Comparison`]).
+//!
+//! Fit is the paper's eq. 5 (`docs/paper.md`): `Fit = 1 - sqrt(sum (y - yhat)^2 / sum (y -
+//! ybar)^2)` with y the reference's values and yhat the setting's.
+
+use scene::palpation::PalpationSetup;
+use scene::run::RunSummary;
+use serde::{Deserialize, Serialize};
+use solver::output::atomic::write_atomic;
+use std::path::Path;
+
+/// One setting: a knob, its value and the palpation it runs.
+#[derive(Clone, Debug)]
+pub struct Variant {
+    /// The knob changed from the base (`reference` and `base` for those two rows).
+    pub knob: String,
+    /// Its value, e.g. `voxel 2.5 mm`.
+    pub setting: String,
+    /// The palpation.
+    pub setup: PalpationSetup,
+}
+
+impl Variant {
+    /// A setting.
+    pub fn new(knob: &str, setting: &str, setup: PalpationSetup) -> Variant {
+        Variant {
+            knob: knob.into(),
+            setting: setting.into(),
+            setup,
+        }
+    }
+
+    /// A file-name form of knob and setting.
+    pub fn slug(&self) -> String {
+        let s: String = format!("{}-{}", self.knob, self.setting)
+            .chars()
+            .map(|c| if c.is_ascii_alphanumeric() { c } else { '_' })
+            .collect();
+        s.split('_')
+            .filter(|p| !p.is_empty())
+            .collect::<Vec<_>>()
+            .join("_")
+    }
+}
+
+/// What one run of the study left: its scene, its cost and the data its errors need.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct RunRecord {
+    /// Location pressed.
+    pub location: String,
+    /// Knob.
+    pub knob: String,
+    /// Setting.
+    pub setting: String,
+    /// How the run ended (`completed` or `failed: ...`).
+    pub status: String,
+    /// Elements.
+    pub elements: usize,
+    /// Steps.
+    pub steps: u64,
+    /// Wall time of the time loop and output (s).
+    pub wall_seconds: f64,
+    /// Element-cycles per second.
+    pub element_cycles_per_second: f64,
+    /// Worker threads.
+    pub threads: usize,
+    /// Mass added by mass scaling, percent of the physical mass.
+    pub added_mass_percent: f64,
+    /// Largest energy imbalance over the largest energy.
+    pub max_energy_error: f64,
+    /// ROI sample times after the start (s).
+    pub sample_times: Vec<f64>,
+    /// Hand force, 1 ms centred average, at each sample time (N).
+    pub force_at_samples: Vec<f64>,
+    /// Largest 1 ms averaged hand force (N).
+    pub peak_force: f64,
+    /// ROI element centroids (m).
+    pub roi_centroids: Vec<[f64; 3]>,
+    /// ROI maximum principal stress (Pa), one row per sample time.
+    pub roi_stress: Vec<Vec<f64>>,
+    /// The scene that ran (`palpa run` repeats it).
+    pub scene: String,
+}
+
+impl RunRecord {
+    /// A record of a run's summary, without its samples yet.
+    pub fn from_summary(location: &str, va: &Variant, scene: String, s: &RunSummary) -> RunRecord {
+        RunRecord {
+            location: location.into(),
+            knob: va.knob.clone(),
+            setting: va.setting.clone(),
+            status: s.status.to_string(),
+            elements: s.elements,
+            steps: s.steps,
+            wall_seconds: s.wall_seconds,
+            element_cycles_per_second: s.element_cycles_per_second,
+            threads: s.threads,
+            added_mass_percent: s.added_mass_percent(),
+            max_energy_error: s.max_energy_error,
+            sample_times: Vec::new(),
+            force_at_samples: Vec::new(),
+            peak_force: f64::NAN,
+            roi_centroids: Vec::new(),
+            roi_stress: Vec::new(),
+            scene,
+        }
+    }
+
+    /// Whether the run completed.
+    pub fn completed(&self) -> bool {
+        self.status == "completed"
+    }
+
+    /// Write the record (atomically: a record is never half-written).
+    pub fn write(&self, path: &Path) -> Result<(), String> {
+        if let Some(d) = path.parent() {
+            std::fs::create_dir_all(d).map_err(|e| format!("{}: {e}", d.display()))?;
+        }
+        let text = serde_json::to_string(self).map_err(|e| format!("{}: {e}", path.display()))?;
+        write_atomic(path, text.as_bytes())
+    }
+
+    /// The record at `path` if there is one and it ran `scene`; `None` if there is none or it
+    /// ran another scene (the plan changed: run it again).
+    pub fn read_if_current(path: &Path, scene: &str) -> Result<Option<RunRecord>, String> {
+        let text = match std::fs::read_to_string(path) {
+            Ok(t) => t,
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(None),
+            Err(e) => return Err(format!("{}: {e}", path.display())),
+        };
+        let r: RunRecord =
+            serde_json::from_str(&text).map_err(|e| format!("{}: {e}", path.display()))?;
+        Ok((r.scene == scene).then_some(r))
+    }
+}
+
+/// Paper eq. 5: the Fit of `yhat` to the reference values `y`.
+pub fn fit(y: &[f64], yhat: &[f64]) -> f64 {
+    let n = y.len().min(yhat.len());
+    if n == 0 {
+        return f64::NAN;
+    }
+    let mean = y[..n].iter().sum::<f64>() / n as f64;
+    let (mut sse, mut sst) = (0.0, 0.0);
+    for (a, b) in y[..n].iter().zip(&yhat[..n]) {
+        sse += (a - b).powi(2);
+        sst += (a - mean).powi(2);
+    }
+    1.0 - (sse / sst.max(1e-300)).sqrt()
+}
+
+/// The share of the reference's peak hand force below which a sample's force error is shown
+/// but not counted in the worst one.
+pub const FORCE_COUNTED: f64 = 0.2;
+
+/// A setting's errors against the reference at the same location.
+#[derive(Clone, Debug)]
+pub struct Comparison {
+    /// Signed relative hand force error at each sample time.
+    pub force_errors: Vec<f64>,
+    /// Whether each sample's force error counts towards the worst one: the reference's force
+    /// there is at least [`FORCE_COUNTED`] of its peak (at 5 ms it is about 1 N of 50, and a
+    /// relative error of a force that small says little about the run).
+    pub force_counted: Vec<bool>,
+    /// ROI stress Fit at each sample time.
+    pub fits: Vec<f64>,
+    /// ROI stress Fit pooled over the samples.
+    pub pooled_fit: f64,
+    /// Fit of the recovered ROI stress ([`RECOVERY_WIDTH`]) at each sample time.
+    pub recovered_fits: Vec<f64>,
+    /// Fit of the recovered ROI stress pooled over the samples.
+    pub pooled_recovered_fit: f64,
+    /// Reference ROI elements compared (those inside the run's ROI patch).
+    pub compared_elements: usize,
+    /// Signed relative error of the peak (1 ms averaged) hand force.
+    pub peak_force_error: f64,
+    /// Signed relative error of the ROI's largest maximum principal stress.
+    pub peak_stress_error: f64,
+}
+
+impl Comparison {
+    /// The largest |force error| over the samples that count ([`Comparison::force_counted`]).
+    pub fn worst_force_error(&self) -> f64 {
+        self.force_errors
+            .iter()
+            .zip(&self.force_counted)
+            .filter(|(_, &c)| c)
+            .fold(
+                0.0,
+                |m: f64, (e, _)| {
+                    if e.is_nan() {
+                        f64::NAN
+                    } else {
+                        m.max(e.abs())
+                    }
+                },
+            )
+    }
+
+    /// The smallest per-sample Fit.
+    pub fn worst_fit(&self) -> f64 {
+        self.fits.iter().copied().fold(f64::INFINITY, f64::min)
+    }
+
+    /// The smallest per-sample Fit of the recovered stress.
+    pub fn worst_recovered_fit(&self) -> f64 {
+        self.recovered_fits
+            .iter()
+            .copied()
+            .fold(f64::INFINITY, f64::min)
+    }
+}
+
+/// Width H of the recovered stress (m): the Gaussian average `sum_j w_j s_j / sum_j w_j`, `w_j =
+/// exp(-|x - x_j|^2 / H^2)` over the ROI elements j, the surrogate's `--recover` target
+/// (`surrogate::recovery`), with which 2.5 and 3 mm meshes agree to Fit 0.82-0.87 where the
+/// element stresses agree to 0.63-0.69 (docs/campaigns.md).
+pub const RECOVERY_WIDTH: f64 = 5e-3;
+
+/// The Gaussian average of one sample's ROI stresses `s` (at `xs`) at `c`.
+fn recovered(xs: &[[f64; 3]], s: &[f64], c: &[f64; 3]) -> f64 {
+    let (mut num, mut den) = (0.0, 0.0);
+    for (x, v) in xs.iter().zip(s) {
+        let d2 = (0..3).map(|k| (x[k] - c[k]).powi(2)).sum::<f64>();
+        let w = (-d2 / (RECOVERY_WIDTH * RECOVERY_WIDTH)).exp();
+        num += w * v;
+        den += w;
+    }
+    num / den.max(1e-300)
+}
+
+/// The reference ROI elements inside the run's ROI patch (within the largest distance of a
+/// run ROI centroid from their mean): a finer mesh's 377 ROI elements cover less of the
+/// liver's surface, and a reference element beyond them has no counterpart.
+fn covered(run: &RunRecord, reference: &RunRecord) -> Vec<usize> {
+    let n = run.roi_centroids.len().max(1) as f64;
+    let mut m = [0.0; 3];
+    for x in &run.roi_centroids {
+        for k in 0..3 {
+            m[k] += x[k] / n;
+        }
+    }
+    let dist = |x: &[f64; 3]| (0..3).map(|k| (x[k] - m[k]).powi(2)).sum::<f64>().sqrt();
+    let r = run.roi_centroids.iter().map(dist).fold(0.0, f64::max);
+    (0..reference.roi_centroids.len())
+        .filter(|&i| dist(&reference.roi_centroids[i]) <= r * (1.0 + 1e-9))
+        .collect()
+}
+
+/// Compare `run` with `reference` (both completed, same location and sample times).
+pub fn compare(run: &RunRecord, reference: &RunRecord) -> Comparison {
+    let rel = |a: f64, b: f64| (a - b) / b;
+    let inside = covered(run, reference);
+    // Each covered reference ROI element's nearest ROI element of the run (the same one on
+    // one mesh).
+    let map: Vec<usize> = inside
+        .iter()
+        .map(|&i| {
+            let c = &reference.roi_centroids[i];
+            let d2 = |q: &[f64; 3]| (0..3).map(|k| (q[k] - c[k]).powi(2)).sum::<f64>();
+            (0..run.roi_centroids.len())
+                .min_by(|&a, &b| d2(&run.roi_centroids[a]).total_cmp(&d2(&run.roi_centroids[b])))
+                .unwrap_or(0)
+        })
+        .collect();
+    let n = run.roi_stress.len().min(reference.roi_stress.len());
+    let at = |row: &[f64], idx: &[usize]| -> Vec<f64> {
+        idx.iter()
+            .map(|&m| row.get(m).copied().unwrap_or(f64::NAN))
+            .collect()
+    };
+    let ref_raw: Vec<Vec<f64>> = (0..n)
+        .map(|k| at(&reference.roi_stress[k], &inside))
+        .collect();
+    let run_raw: Vec<Vec<f64>> = (0..n).map(|k| at(&run.roi_stress[k], &map)).collect();
+    let rec = |r: &RunRecord, k: usize| -> Vec<f64> {
+        inside
+            .iter()
+            .map(|&i| {
+                recovered(
+                    &r.roi_centroids,
+                    &r.roi_stress[k],
+                    &reference.roi_centroids[i],
+                )
+            })
+            .collect()
+    };
+    let ref_rec: Vec<Vec<f64>> = (0..n).map(|k| rec(reference, k)).collect();
+    let run_rec: Vec<Vec<f64>> = (0..n).map(|k| rec(run, k)).collect();
+    let fits = (0..n).map(|k| fit(&ref_raw[k], &run_raw[k])).collect();
+    let recovered_fits = (0..n).map(|k| fit(&ref_rec[k], &run_rec[k])).collect();
+    let flat = |s: &[Vec<f64>]| s.iter().flatten().copied().collect::<Vec<f64>>();
+    let peak = |s: &[Vec<f64>]| {
+        s.iter()
+            .flatten()
+            .copied()
+            .fold(f64::NEG_INFINITY, f64::max)
+    };
+    Comparison {
+        force_errors: run
+            .force_at_samples
+            .iter()
+            .zip(&reference.force_at_samples)
+            .map(|(&a, &b)| rel(a, b))
+            .collect(),
+        force_counted: reference
+            .force_at_samples
+            .iter()
+            .map(|&f| f >= FORCE_COUNTED * reference.peak_force)
+            .collect(),
+        fits,
+        pooled_fit: fit(&flat(&ref_raw), &flat(&run_raw)),
+        recovered_fits,
+        pooled_recovered_fit: fit(&flat(&ref_rec), &flat(&run_rec)),
+        compared_elements: inside.len(),
+        peak_force_error: rel(run.peak_force, reference.peak_force),
+        peak_stress_error: rel(peak(&run.roi_stress), peak(&reference.roi_stress)),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn record(force: Vec<f64>, centroids: Vec<[f64; 3]>, stress: Vec<Vec<f64>>) -> RunRecord {
+        RunRecord {
+            location: "A".into(),
+            knob: "k".into(),
+            setting: "s".into(),
+            status: "completed".into(),
+            elements: 1,
+            steps: 1,
+            wall_seconds: 1.0,
+            element_cycles_per_second: 1.0,
+            threads: 1,
+            added_mass_percent: 0.0,
+            max_energy_error: 0.0,
+            sample_times: vec![0.01, 0.02],
+            peak_force: force.iter().copied().fold(0.0, f64::max),
+            force_at_samples: force,
+            roi_centroids: centroids,
+            roi_stress: stress,
+            scene: String::new(),
+        }
+    }
+
+    #[test]
+    fn itself_is_exact_and_a_shifted_field_loses_what_eq5_says() {
+        let c = vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [2.0, 0.0, 0.0]];
+        let s = vec![vec![1.0, 2.0, 3.0], vec![2.0, 4.0, 6.0]];
+        let r = record(vec![10.0, 20.0], c.clone(), s.clone());
+        let same = compare(&r, &r);
+        assert_eq!(same.pooled_fit, 1.0);
+        assert_eq!(same.worst_force_error(), 0.0);
+        // +1 on every element at the first sample: sse = 3, sst = 2, Fit = 1 - sqrt(3/2).
+        let shifted = record(
+            vec![11.0, 18.0],
+            c,
+            vec![vec![2.0, 3.0, 4.0], vec![2.0, 4.0, 6.0]],
+        );
+        let d = compare(&shifted, &r);
+        assert!((d.fits[0] - (1.0 - 1.5f64.sqrt())).abs() < 1e-12);
+        assert_eq!(d.fits[1], 1.0);
+        assert!((d.force_errors[0] - 0.1).abs() < 1e-12);
+        assert!((d.force_errors[1] + 0.1).abs() < 1e-12);
+        assert!((d.worst_force_error() - 0.1).abs() < 1e-12);
+        assert!((d.peak_force_error + 0.1).abs() < 1e-12);
+        assert_eq!(d.peak_stress_error, 0.0);
+    }
+
+    #[test]
+    fn another_mesh_is_read_at_the_nearest_centroid() {
+        let r = record(
+            vec![1.0],
+            vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0]],
+            vec![vec![1.0, 3.0]],
+        );
+        // A finer run: four elements, two of them nearest to the reference's two.
+        let fine = record(
+            vec![1.0],
+            vec![
+                [-0.1, 0.0, 0.0],
+                [0.45, 0.0, 0.0],
+                [0.55, 0.0, 0.0],
+                [1.1, 0.0, 0.0],
+            ],
+            vec![vec![1.0, 7.0, 7.0, 3.0]],
+        );
+        let d = compare(&fine, &r);
+        assert_eq!(d.compared_elements, 2);
+        assert_eq!(d.fits[0], 1.0);
+        // its peak is the finer mesh's own: 7 against 3
+        assert!((d.peak_stress_error - 4.0 / 3.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn a_smaller_patch_compares_what_it_covers() {
+        let r = record(
+            vec![1.0],
+            vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0]],
+            vec![vec![1.0, 3.0]],
+        );
+        let small = record(
+            vec![1.0],
+            vec![[-0.1, 0.0, 0.0], [0.1, 0.0, 0.0]],
+            vec![vec![1.0, 1.0]],
+        );
+        assert_eq!(compare(&small, &r).compared_elements, 1);
+    }
+
+    #[test]
+    fn the_recovered_stress_is_the_gaussian_average() {
+        let h = RECOVERY_WIDTH;
+        let xs = [[0.0, 0.0, 0.0], [h, 0.0, 0.0]];
+        // at x = 0: weights 1 and e^-1
+        let w = (-1.0f64).exp();
+        let v = recovered(&xs, &[1.0, 3.0], &[0.0, 0.0, 0.0]);
+        assert!((v - (1.0 + 3.0 * w) / (1.0 + w)).abs() < 1e-12);
+    }
+
+    #[test]
+    fn slugs_are_file_names() {
+        let v = Variant::new("bulk ratio", "K/G <= 1000", PalpationSetup::default());
+        assert_eq!(v.slug(), "bulk_ratio_K_G_1000");
+    }
+}
