@@ -137,10 +137,11 @@ impl Fidelity {
         match self {
             Fidelity::Standard => "standard (the options as given)",
             Fidelity::Fast => {
-                "fast (1pt-physical, K/G <= 5000, f32 kernels): measured at 5 mm, location A, against F-bar at full K \
-                 in f64: hand force within 10 % (-4 .. -10 % at 10-24.5 ms), ROI stress Fit 0.88 (0.79-0.91 per sample), \
-                 3.2x fewer steps; f32 alone moves the 1 ms hand force by at most 0.7 % and keeps ROI Fit 0.9995; \
-                 the standard default: force -12 .. -23 %, Fit 0.65"
+                "fast (1pt-physical, K/G <= 5000, f32 kernels): measured at 3 mm (campaign phantom, location A; \
+                 docs/study/README.md) against F-bar at the laws' K in f64: hand force within 6 % from 10 ms on, \
+                 ROI stress Fit 0.81-0.94 per sample (0.93 pooled), 1/15 of the reference's wall time; at 5 mm, \
+                 location A: force -4 .. -10 %, Fit 0.88; f32 alone moves the 1 ms hand force by at most 0.7 % \
+                 and keeps ROI Fit 0.9995; the standard default at 5 mm: force -12 .. -23 %, Fit 0.65"
             }
         }
     }
