@@ -171,11 +171,7 @@ fn run_one(
         phantoms.insert(key, p);
     }
     let mut scene = setup.build_scene(dir, phantoms.get(&key).cloned())?;
-    let centroids = scene
-        .phantom
-        .as_ref()
-        .map(|p| p.roi.centroids.clone())
-        .unwrap_or_default();
+    let roi = scene.phantom.as_ref().map(|p| p.roi.clone());
     let stop = AtomicBool::new(false);
     let (summary, err) = run_scene(&mut scene, dir, &stop, |_| {});
     if let Some(e) = err {
@@ -185,6 +181,10 @@ fn run_one(
     let time = column(&cols, &rows, "time").ok_or("history without time")?;
     let force = column(&cols, &rows, "hand_reaction").ok_or("history without hand_reaction")?;
     let probe = read_probe(dir, "hand")?;
+    let centroids = match &roi {
+        Some(roi) => probe_centroids(roi, &probe)?,
+        None => Vec::new(),
+    };
     Ok(RunData {
         summary,
         time,
@@ -192,6 +192,28 @@ fn run_one(
         probe,
         centroids,
     })
+}
+
+/// The centroid of each of the probe's ROI elements, in the probe's column order (the probe
+/// reads the ROI element set, sorted by element id; the phantom's [`phantom::Roi`] lists them
+/// nearest to its centre first).
+pub fn probe_centroids(roi: &phantom::Roi, probe: &ProbeSamples) -> Result<Vec<[f64; 3]>, String> {
+    let by_id: HashMap<u32, [f64; 3]> = roi
+        .elements
+        .iter()
+        .copied()
+        .zip(roi.centroids.iter().copied())
+        .collect();
+    probe
+        .elements
+        .iter()
+        .map(|e| {
+            by_id
+                .get(e)
+                .copied()
+                .ok_or_else(|| format!("probe element {e} is not in the phantom's ROI"))
+        })
+        .collect()
 }
 
 /// Relative RMS force error of `r` against `reference`, both filtered ([`FORCE_FILTER`]).

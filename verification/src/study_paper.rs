@@ -42,6 +42,7 @@
 //! for is read instead of run again, so an interrupted study goes on where it stopped and the
 //! report can be rebuilt from committed records alone.
 
+use crate::study::probe_centroids;
 use crate::study_paper_record::{RunRecord, Variant};
 use phantom::Phantom;
 use scene::palpation::{read_probe, ElementChoice, Fidelity, PalpationSetup, Place};
@@ -185,11 +186,7 @@ fn run_or_read(
         phantoms.insert(key, phantom::build(&va.setup.phantom_params()?)?);
     }
     let mut sc = va.setup.build_scene(&dir, phantoms.get(&key).cloned())?;
-    let centroids = sc
-        .phantom
-        .as_ref()
-        .map(|p| p.roi.centroids.clone())
-        .unwrap_or_default();
+    let roi = sc.phantom.as_ref().map(|p| p.roi.clone());
     let stop = AtomicBool::new(false);
     let (summary, err) = run_scene(&mut sc, &dir, &stop, |_| {});
     let mut rec = RunRecord::from_summary(location, va, scene, &summary);
@@ -214,7 +211,10 @@ fn run_or_read(
         rec.peak_force = moving_average(&time, &force, FORCE_FILTER)
             .into_iter()
             .fold(0.0, f64::max);
-        rec.roi_centroids = centroids;
+        if let Some(roi) = &roi {
+            rec.roi_centroids = probe_centroids(roi, &probe)?;
+        }
+        rec.roi_elements = probe.elements.clone();
         rec.roi_stress = keep.iter().map(|&k| probe.stress[k].clone()).collect();
     }
     rec.write(&path)?;

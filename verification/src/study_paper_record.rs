@@ -75,7 +75,9 @@ pub struct RunRecord {
     pub force_at_samples: Vec<f64>,
     /// Largest 1 ms averaged hand force (N).
     pub peak_force: f64,
-    /// ROI element centroids (m).
+    /// ROI element ids, in the probe's order (sorted).
+    pub roi_elements: Vec<u32>,
+    /// ROI element centroids (m), same order.
     pub roi_centroids: Vec<[f64; 3]>,
     /// ROI maximum principal stress (Pa), one row per sample time.
     pub roi_stress: Vec<Vec<f64>>,
@@ -101,6 +103,7 @@ impl RunRecord {
             sample_times: Vec::new(),
             force_at_samples: Vec::new(),
             peak_force: f64::NAN,
+            roi_elements: Vec::new(),
             roi_centroids: Vec::new(),
             roi_stress: Vec::new(),
             scene,
@@ -339,6 +342,7 @@ mod tests {
             sample_times: vec![0.01, 0.02],
             peak_force: force.iter().copied().fold(0.0, f64::max),
             force_at_samples: force,
+            roi_elements: Vec::new(),
             roi_centroids: centroids,
             roi_stress: stress,
             scene: String::new(),
