@@ -107,9 +107,10 @@ impl std::str::FromStr for ElementChoice {
 }
 
 /// A named setting of the knobs that trade accuracy for time (`--fidelity` of `palpate`,
-/// `solver.fidelity` of a campaign). Measured on the 5 mm phantom at location A against
-/// fully integrated F-bar elements at the laws' own bulk modulus (docs/palpate.md, section
-/// "Element and incompressibility").
+/// `solver.fidelity` of a campaign). Measured at location A against fully integrated F-bar
+/// elements at the laws' own bulk modulus, on the 5 mm phantom (docs/palpate.md, section
+/// "Element and incompressibility") and at 3 mm on the campaign phantom (docs/study/README.md,
+/// `palpa study --paper`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Fidelity {
     /// The options as given (by default: one-point elements with shear-scaled viscous

@@ -10,6 +10,7 @@ use indicatif::{ProgressBar, ProgressStyle};
 use scene::run::RunStatus;
 use solver::output::atomic::write_atomic;
 use std::path::Path;
+use verification::study_paper_record::RunRecord;
 use verification::{study_paper, study_paper_report};
 
 /// A progress bar, hidden when `quiet`.
@@ -87,6 +88,7 @@ pub fn study_paper(
     mode: PaperMode,
     quiet: bool,
 ) -> Result<(), String> {
+    let mut locs: Vec<String> = Vec::new();
     for l in locations {
         if !study_paper::LOCATIONS.contains(&l.as_str()) {
             return Err(format!(
@@ -94,22 +96,28 @@ pub fn study_paper(
                 study_paper::LOCATIONS.join(", ")
             ));
         }
+        if !locs.contains(l) {
+            locs.push(l.clone());
+        }
     }
+    let locations = &locs[..];
     if mode == PaperMode::DryRun {
         for l in locations {
             for va in study_paper::plan(l) {
                 let path = study_paper::record_path(out, l, &va);
-                let have = verification::study_paper_record::RunRecord::read_if_current(
-                    &path,
-                    &va.setup.scene_toml(),
-                )?
-                .is_some();
-                println!(
-                    "{l}  {} = {}  ({})",
-                    va.knob,
-                    va.setting,
-                    if have { "recorded" } else { "to run" }
-                );
+                let state = match RunRecord::read(&path)? {
+                    None => "to run".to_string(),
+                    Some(r) if !r.is_current(&va.setup.scene_toml()) => {
+                        "stale: another scene or record format; runs again".into()
+                    }
+                    Some(r) if r.completed() => "recorded".into(),
+                    Some(r) => format!(
+                        "recorded ({}; delete {} to run it again)",
+                        r.status,
+                        path.display()
+                    ),
+                };
+                println!("{l}  {} = {}  ({state})", va.knob, va.setting);
             }
         }
         return Ok(());
@@ -129,7 +137,8 @@ pub fn study_paper(
     };
     if records.is_empty() {
         return Err(format!(
-            "{}: no study records to report (run `palpa study --paper` first)",
+            "{}: no current study records to report (none, or all of another scene or record \
+             format: `palpa study --paper --dry-run` lists them; run `palpa study --paper`)",
             out.join("records").display()
         ));
     }

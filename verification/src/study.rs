@@ -42,12 +42,19 @@ use std::sync::atomic::AtomicBool;
 use crate::study_row::StudyRow;
 
 /// What one run left behind, for the error computation.
-struct RunData {
-    summary: RunSummary,
-    time: Vec<f64>,
-    force: Vec<f64>,
-    probe: ProbeSamples,
-    centroids: Vec<[f64; 3]>,
+pub(crate) struct RunData {
+    /// The run's summary.
+    pub summary: RunSummary,
+    /// Why the run failed (its other fields are then empty).
+    pub error: Option<String>,
+    /// History times (s).
+    pub time: Vec<f64>,
+    /// Hand force history (N).
+    pub force: Vec<f64>,
+    /// The ROI samples.
+    pub probe: ProbeSamples,
+    /// The centroid of each probe ROI element, in the probe's order.
+    pub centroids: Vec<[f64; 3]>,
 }
 
 /// One setting of the study.
@@ -158,8 +165,9 @@ fn plan(quick: bool) -> Vec<Variant> {
     v
 }
 
-/// Run one setting into `dir`, sharing phantoms by voxel size.
-fn run_one(
+/// Run one setting into `dir`, sharing phantoms by voxel size. A run that fails returns its
+/// summary and error; only an unreadable output is an `Err`.
+pub(crate) fn run_one(
     setup: &PalpationSetup,
     dir: &Path,
     phantoms: &mut HashMap<u64, Phantom>,
@@ -175,7 +183,14 @@ fn run_one(
     let stop = AtomicBool::new(false);
     let (summary, err) = run_scene(&mut scene, dir, &stop, |_| {});
     if let Some(e) = err {
-        return Err(e);
+        return Ok(RunData {
+            summary,
+            error: Some(e),
+            time: Vec::new(),
+            force: Vec::new(),
+            probe: ProbeSamples::default(),
+            centroids: Vec::new(),
+        });
     }
     let (cols, rows) = read_history(&dir.join("history.csv"))?;
     let time = column(&cols, &rows, "time").ok_or("history without time")?;
@@ -187,6 +202,7 @@ fn run_one(
     };
     Ok(RunData {
         summary,
+        error: None,
         time,
         force,
         probe,
@@ -216,6 +232,17 @@ pub fn probe_centroids(roi: &phantom::Roi, probe: &ProbeSamples) -> Result<Vec<[
         .collect()
 }
 
+/// The index of the point of `xs` nearest to `c` and its distance (0 and infinity for none).
+pub fn nearest(xs: &[[f64; 3]], c: &[f64; 3]) -> (usize, f64) {
+    let d2 = |q: &[f64; 3]| (0..3).map(|k| (q[k] - c[k]).powi(2)).sum::<f64>();
+    xs.iter()
+        .enumerate()
+        .map(|(i, q)| (i, d2(q)))
+        .min_by(|a, b| a.1.total_cmp(&b.1))
+        .map(|(i, d)| (i, d.sqrt()))
+        .unwrap_or((0, f64::INFINITY))
+}
+
 /// Relative RMS force error of `r` against `reference`, both filtered ([`FORCE_FILTER`]).
 fn force_error(r: &RunData, reference: &RunData) -> f64 {
     let fr_s = moving_average(&reference.time, &reference.force, FORCE_FILTER);
@@ -234,12 +261,7 @@ fn stress_error(r: &RunData, reference: &RunData) -> f64 {
     let map: Vec<usize> = reference
         .centroids
         .iter()
-        .map(|c| {
-            let d2 = |q: &[f64; 3]| (0..3).map(|k| (q[k] - c[k]).powi(2)).sum::<f64>();
-            (0..r.centroids.len())
-                .min_by(|&a, &b| d2(&r.centroids[a]).total_cmp(&d2(&r.centroids[b])))
-                .unwrap_or(0)
-        })
+        .map(|c| nearest(&r.centroids, c).0)
         .collect();
     let (mut num, mut den) = (0.0, 0.0);
     for (k, sref) in reference.probe.stress.iter().enumerate() {
@@ -273,7 +295,12 @@ pub fn run_study(
             i,
             format!("{}-{}", va.knob, va.setting).replace([' ', '/', '.'], "_")
         ));
-        data.push(run_one(&va.setup, &dir, &mut phantoms));
+        data.push(
+            run_one(&va.setup, &dir, &mut phantoms).and_then(|d| match d.error {
+                Some(e) => Err(e),
+                None => Ok(d),
+            }),
+        );
     }
     let mut rows = variants
         .iter()

@@ -42,18 +42,15 @@
 //! for is read instead of run again, so an interrupted study goes on where it stopped and the
 //! report can be rebuilt from committed records alone.
 
-use crate::study::probe_centroids;
-use crate::study_paper_record::{RunRecord, Variant};
+use crate::study::run_one;
+use crate::study_paper_record::{RunRecord, StudySetting};
 use phantom::Phantom;
-use scene::palpation::{read_probe, ElementChoice, Fidelity, PalpationSetup, Place};
-use scene::run::{run_scene, RunStatus};
+use scene::palpation::{ElementChoice, Fidelity, PalpationSetup, Place};
+use scene::run::RunStatus;
 use solver::element::precision::Precision;
 use solver::model::StepTarget;
-use solver::output::filter::{moving_average, moving_average_at, FORCE_FILTER};
-use solver::output::history::{column, read_history};
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
-use std::sync::atomic::AtomicBool;
 
 /// The locations of the study.
 pub const LOCATIONS: [&str; 3] = ["A", "B", "C"];
@@ -80,7 +77,7 @@ pub fn base_setup(location: &str) -> PalpationSetup {
 
 /// The settings of the study at one location: the reference first, then the base, then one
 /// change of one knob of the base per setting.
-pub fn plan(location: &str) -> Vec<Variant> {
+pub fn plan(location: &str) -> Vec<StudySetting> {
     let base = base_setup(location);
     // A changed knob is no longer the preset.
     let one = |f: &dyn Fn(&mut PalpationSetup)| {
@@ -90,7 +87,7 @@ pub fn plan(location: &str) -> Vec<Variant> {
         s
     };
     let mut v = vec![
-        Variant::new(
+        StudySetting::new(
             REFERENCE,
             "F-bar, laws' K, f64, mass scaling to the initial step",
             one(&|s| {
@@ -99,45 +96,45 @@ pub fn plan(location: &str) -> Vec<Variant> {
                 s.precision = Precision::F64;
             }),
         ),
-        Variant::new(
+        StudySetting::new(
             BASE,
             "fast preset (1pt-physical, K/G <= 5000, f32, 3 mm)",
             base.clone(),
         ),
     ];
     for (mm, h) in [("4", 0.004), ("2.5", 0.0025)] {
-        v.push(Variant::new(
+        v.push(StudySetting::new(
             "mesh",
             &format!("voxel {mm} mm"),
             one(&|s| s.voxel = h),
         ));
     }
     for el in [ElementChoice::OnePointViscousShear, ElementChoice::FullFbar] {
-        v.push(Variant::new(
+        v.push(StudySetting::new(
             "element",
             el.label(),
             one(&|s| s.element = el),
         ));
     }
-    v.push(Variant::new(
+    v.push(StudySetting::new(
         "bulk ratio",
         "laws' own (K/G 5e4)",
         one(&|s| s.max_bulk_ratio = None),
     ));
     for r in [1e3, 5e2] {
-        v.push(Variant::new(
+        v.push(StudySetting::new(
             "bulk ratio",
             &format!("K/G <= {r}"),
             one(&|s| s.max_bulk_ratio = Some(r)),
         ));
     }
-    v.push(Variant::new(
+    v.push(StudySetting::new(
         "mass scaling",
         "off",
         one(&|s| s.mass_scaling = None),
     ));
     for k in [1.3, 2.0] {
-        v.push(Variant::new(
+        v.push(StudySetting::new(
             "mass scaling",
             &format!("{k} x initial step"),
             one(&|s| {
@@ -147,13 +144,13 @@ pub fn plan(location: &str) -> Vec<Variant> {
         ));
     }
     for f in [0.5, 0.75] {
-        v.push(Variant::new(
+        v.push(StudySetting::new(
             "dt factor",
             &format!("{f}"),
             one(&|s| s.dt_factor = f),
         ));
     }
-    v.push(Variant::new(
+    v.push(StudySetting::new(
         "precision",
         "f64",
         one(&|s| s.precision = Precision::F64),
@@ -162,7 +159,7 @@ pub fn plan(location: &str) -> Vec<Variant> {
 }
 
 /// Where a setting's record lives.
-pub fn record_path(out: &Path, location: &str, va: &Variant) -> PathBuf {
+pub fn record_path(out: &Path, location: &str, va: &StudySetting) -> PathBuf {
     out.join("records")
         .join(format!("{location}-{}.json", va.slug()))
 }
@@ -171,51 +168,20 @@ pub fn record_path(out: &Path, location: &str, va: &Variant) -> PathBuf {
 fn run_or_read(
     out: &Path,
     location: &str,
-    va: &Variant,
+    va: &StudySetting,
     phantoms: &mut HashMap<u64, Phantom>,
 ) -> Result<RunRecord, String> {
     let path = record_path(out, location, va);
     let scene = va.setup.scene_toml();
-    if let Some(r) = RunRecord::read_if_current(&path, &scene)? {
+    if let Some(r) = RunRecord::read(&path)?.filter(|r| r.is_current(&scene)) {
         return Ok(r);
     }
     let dir = out.join("runs").join(location).join(va.slug());
-    std::fs::create_dir_all(&dir).map_err(|e| format!("{}: {e}", dir.display()))?;
-    let key = va.setup.voxel.to_bits();
-    if !phantoms.contains_key(&key) {
-        phantoms.insert(key, phantom::build(&va.setup.phantom_params()?)?);
-    }
-    let mut sc = va.setup.build_scene(&dir, phantoms.get(&key).cloned())?;
-    let roi = sc.phantom.as_ref().map(|p| p.roi.clone());
-    let stop = AtomicBool::new(false);
-    let (summary, err) = run_scene(&mut sc, &dir, &stop, |_| {});
-    let mut rec = RunRecord::from_summary(location, va, scene, &summary);
-    if let Some(e) = err {
-        rec.status = RunStatus::Failed(e).to_string();
-    } else {
-        let (cols, rows) = read_history(&dir.join("history.csv"))?;
-        let time = column(&cols, &rows, "time").ok_or("history without time")?;
-        let force = column(&cols, &rows, "hand_reaction").ok_or("history without hand_reaction")?;
-        let probe = read_probe(&dir, "hand")?;
-        let keep: Vec<usize> = (0..probe.time.len())
-            .filter(|&k| probe.time[k] > 0.0)
-            .collect();
-        rec.sample_times = keep.iter().map(|&k| probe.time[k]).collect();
-        let end = time.last().copied().unwrap_or(0.0);
-        let at: Vec<f64> = rec
-            .sample_times
-            .iter()
-            .map(|&t| t.min(end - 0.5 * FORCE_FILTER))
-            .collect();
-        rec.force_at_samples = moving_average_at(&time, &force, FORCE_FILTER, &at);
-        rec.peak_force = moving_average(&time, &force, FORCE_FILTER)
-            .into_iter()
-            .fold(0.0, f64::max);
-        if let Some(roi) = &roi {
-            rec.roi_centroids = probe_centroids(roi, &probe)?;
-        }
-        rec.roi_elements = probe.elements.clone();
-        rec.roi_stress = keep.iter().map(|&k| probe.stress[k].clone()).collect();
+    let d = run_one(&va.setup, &dir, phantoms)?;
+    let mut rec = RunRecord::from_summary(location, va, scene, &d.summary);
+    match &d.error {
+        Some(e) => rec.status = RunStatus::Failed(e.clone()).to_string(),
+        None => rec.take_samples(&d),
     }
     rec.write(&path)?;
     Ok(rec)
@@ -230,7 +196,7 @@ pub fn run(
     mut progress: impl FnMut(usize, usize, &str),
 ) -> Result<Vec<RunRecord>, String> {
     let mut phantoms = HashMap::new();
-    let plans: Vec<(String, Vec<Variant>)> =
+    let plans: Vec<(String, Vec<StudySetting>)> =
         locations.iter().map(|l| (l.clone(), plan(l))).collect();
     let n: usize = plans.iter().map(|p| p.1.len()).sum();
     let mut records = Vec::new();
@@ -254,10 +220,78 @@ pub fn read_records(out: &Path, locations: &[String]) -> Result<Vec<RunRecord>, 
     for loc in locations {
         for va in plan(loc) {
             let path = record_path(out, loc, &va);
-            if let Some(r) = RunRecord::read_if_current(&path, &va.setup.scene_toml())? {
+            if let Some(r) =
+                RunRecord::read(&path)?.filter(|r| r.is_current(&va.setup.scene_toml()))
+            {
                 records.push(r);
             }
         }
     }
     Ok(records)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Each setting differs from the base in its own knob's fields only (and in not being
+    /// the preset); the reference in the element, the bulk modulus and the precision.
+    #[test]
+    fn each_setting_changes_one_knob() {
+        let base = base_setup("B");
+        let settings = plan("B");
+        assert_eq!(settings[0].knob, REFERENCE);
+        assert_eq!(settings[1].knob, BASE);
+        assert_eq!(settings[1].setup, base);
+        for st in &settings[2..] {
+            let mut s = st.setup.clone();
+            match st.knob.as_str() {
+                "mesh" => s.voxel = base.voxel,
+                "element" => s.element = base.element,
+                "bulk ratio" => s.max_bulk_ratio = base.max_bulk_ratio,
+                "mass scaling" => {
+                    s.mass_scaling = base.mass_scaling;
+                    s.mass_scaling_limit = base.mass_scaling_limit;
+                }
+                "dt factor" => s.dt_factor = base.dt_factor,
+                "precision" => s.precision = base.precision,
+                k => panic!("unknown knob {k}"),
+            }
+            assert_ne!(st.setup, s, "{} = {} changes nothing", st.knob, st.setting);
+            s.fidelity = base.fidelity;
+            assert_eq!(
+                s, base,
+                "{} = {} changes more than its knob",
+                st.knob, st.setting
+            );
+        }
+        let mut r = settings[0].setup.clone();
+        assert_eq!(r.element, ElementChoice::FullFbar);
+        r.element = base.element;
+        r.max_bulk_ratio = base.max_bulk_ratio;
+        r.precision = base.precision;
+        r.fidelity = base.fidelity;
+        assert_eq!(r, base);
+    }
+
+    #[test]
+    fn probe_centroids_follow_the_probe_order() {
+        let roi = phantom::Roi {
+            center: [0.0; 3],
+            elements: vec![5, 2, 9],
+            centroids: vec![[5.0, 0.0, 0.0], [2.0, 0.0, 0.0], [9.0, 0.0, 0.0]],
+        };
+        let probe = scene::palpation::ProbeSamples {
+            elements: vec![2, 5, 9],
+            ..Default::default()
+        };
+        let c = crate::study::probe_centroids(&roi, &probe).unwrap();
+        assert_eq!(c, vec![[2.0, 0.0, 0.0], [5.0, 0.0, 0.0], [9.0, 0.0, 0.0]]);
+        let stranger = scene::palpation::ProbeSamples {
+            elements: vec![2, 7],
+            ..Default::default()
+        };
+        let e = crate::study::probe_centroids(&roi, &stranger).unwrap_err();
+        assert!(e.contains("probe element 7"), "{e}");
+    }
 }

@@ -4,15 +4,18 @@
 //! Fit is the paper's eq. 5 (`docs/paper.md`): `Fit = 1 - sqrt(sum (y - yhat)^2 / sum (y -
 //! ybar)^2)` with y the reference's values and yhat the setting's.
 
+use crate::study::{nearest, RunData};
+use ndarray::ArrayView2;
 use scene::palpation::PalpationSetup;
 use scene::run::RunSummary;
 use serde::{Deserialize, Serialize};
 use solver::output::atomic::write_atomic;
+use solver::output::filter::{moving_average, moving_average_at, FORCE_FILTER};
 use std::path::Path;
 
 /// One setting: a knob, its value and the palpation it runs.
 #[derive(Clone, Debug)]
-pub struct Variant {
+pub struct StudySetting {
     /// The knob changed from the base (`reference` and `base` for those two rows).
     pub knob: String,
     /// Its value, e.g. `voxel 2.5 mm`.
@@ -21,10 +24,10 @@ pub struct Variant {
     pub setup: PalpationSetup,
 }
 
-impl Variant {
+impl StudySetting {
     /// A setting.
-    pub fn new(knob: &str, setting: &str, setup: PalpationSetup) -> Variant {
-        Variant {
+    pub fn new(knob: &str, setting: &str, setup: PalpationSetup) -> StudySetting {
+        StudySetting {
             knob: knob.into(),
             setting: setting.into(),
             setup,
@@ -44,9 +47,16 @@ impl Variant {
     }
 }
 
+/// The record format: a record of another one (or none, written before the field existed) is
+/// stale and runs again. 2: ROI centroids paired with the probe's element order.
+pub const FORMAT: u32 = 2;
+
 /// What one run of the study left: its scene, its cost and the data its errors need.
 #[derive(Clone, Debug, Serialize, Deserialize)]
 pub struct RunRecord {
+    /// Record format ([`FORMAT`]).
+    #[serde(default)]
+    pub format: u32,
     /// Location pressed.
     pub location: String,
     /// Knob.
@@ -76,6 +86,7 @@ pub struct RunRecord {
     /// Largest 1 ms averaged hand force (N).
     pub peak_force: f64,
     /// ROI element ids, in the probe's order (sorted).
+    #[serde(default)]
     pub roi_elements: Vec<u32>,
     /// ROI element centroids (m), same order.
     pub roi_centroids: Vec<[f64; 3]>,
@@ -87,8 +98,14 @@ pub struct RunRecord {
 
 impl RunRecord {
     /// A record of a run's summary, without its samples yet.
-    pub fn from_summary(location: &str, va: &Variant, scene: String, s: &RunSummary) -> RunRecord {
+    pub fn from_summary(
+        location: &str,
+        va: &StudySetting,
+        scene: String,
+        s: &RunSummary,
+    ) -> RunRecord {
         RunRecord {
+            format: FORMAT,
             location: location.into(),
             knob: va.knob.clone(),
             setting: va.setting.clone(),
@@ -124,33 +141,93 @@ impl RunRecord {
         write_atomic(path, text.as_bytes())
     }
 
-    /// The record at `path` if there is one and it ran `scene`; `None` if there is none or it
-    /// ran another scene (the plan changed: run it again).
-    pub fn read_if_current(path: &Path, scene: &str) -> Result<Option<RunRecord>, String> {
+    /// The record at `path`, `None` if there is none.
+    pub fn read(path: &Path) -> Result<Option<RunRecord>, String> {
         let text = match std::fs::read_to_string(path) {
             Ok(t) => t,
             Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(None),
             Err(e) => return Err(format!("{}: {e}", path.display())),
         };
-        let r: RunRecord =
-            serde_json::from_str(&text).map_err(|e| format!("{}: {e}", path.display()))?;
-        Ok((r.scene == scene).then_some(r))
+        serde_json::from_str(&text)
+            .map(Some)
+            .map_err(|e| format!("{}: not a study record: {e}", path.display()))
+    }
+
+    /// Whether the record is of this format and ran `scene` (else the plan or the format
+    /// changed: run it again).
+    pub fn is_current(&self, scene: &str) -> bool {
+        self.format == FORMAT && self.scene == scene
+    }
+
+    /// Take a completed run's samples: the ROI samples after the start, the 1 ms averaged hand
+    /// force at their times (at the end, half a window before it) and its peak (over the
+    /// times whose window lies inside the run), the ROI's elements and centroids.
+    pub(crate) fn take_samples(&mut self, d: &RunData) {
+        let p = &d.probe;
+        let keep: Vec<usize> = (0..p.time.len()).filter(|&k| p.time[k] > 0.0).collect();
+        self.sample_times = keep.iter().map(|&k| p.time[k]).collect();
+        let end = d.time.last().copied().unwrap_or(0.0);
+        let half = 0.5 * FORCE_FILTER;
+        let at: Vec<f64> = self
+            .sample_times
+            .iter()
+            .map(|&t| t.min(end - half))
+            .collect();
+        self.force_at_samples = moving_average_at(&d.time, &d.force, FORCE_FILTER, &at);
+        self.peak_force = moving_average(&d.time, &d.force, FORCE_FILTER)
+            .into_iter()
+            .zip(&d.time)
+            .filter(|(_, &t)| t >= half && t <= end - half)
+            .map(|(f, _)| f)
+            .fold(f64::NEG_INFINITY, |m, f| {
+                if f.is_nan() || m.is_nan() {
+                    f64::NAN
+                } else {
+                    m.max(f)
+                }
+            });
+        self.roi_elements = p.elements.clone();
+        self.roi_centroids = d.centroids.clone();
+        self.roi_stress = keep.iter().map(|&k| p.stress[k].clone()).collect();
+    }
+
+    /// Why the record's samples cannot be compared (inconsistent shapes), if they cannot.
+    pub fn shape_error(&self) -> Option<String> {
+        let r = self.roi_centroids.len();
+        if r == 0 || self.roi_elements.len() != r {
+            return Some(format!(
+                "{} ROI elements with {} centroids",
+                self.roi_elements.len(),
+                r
+            ));
+        }
+        if self.roi_stress.len() != self.sample_times.len()
+            || self.force_at_samples.len() != self.sample_times.len()
+        {
+            return Some(format!(
+                "{} sample times, {} force samples, {} stress rows",
+                self.sample_times.len(),
+                self.force_at_samples.len(),
+                self.roi_stress.len()
+            ));
+        }
+        self.roi_stress
+            .iter()
+            .any(|row| row.len() != r)
+            .then(|| format!("a stress row without {r} values"))
     }
 }
 
-/// Paper eq. 5: the Fit of `yhat` to the reference values `y`.
+/// Paper eq. 5: the Fit of `yhat` to the reference values `y` ([`surrogate::compute_fit`]:
+/// NaN when the lengths differ, the set is empty or `y` is constant).
 pub fn fit(y: &[f64], yhat: &[f64]) -> f64 {
-    let n = y.len().min(yhat.len());
-    if n == 0 {
-        return f64::NAN;
+    match (
+        ArrayView2::from_shape((1, y.len()), y),
+        ArrayView2::from_shape((1, yhat.len()), yhat),
+    ) {
+        (Ok(a), Ok(b)) => surrogate::compute_fit(a, b),
+        _ => f64::NAN,
     }
-    let mean = y[..n].iter().sum::<f64>() / n as f64;
-    let (mut sse, mut sst) = (0.0, 0.0);
-    for (a, b) in y[..n].iter().zip(&yhat[..n]) {
-        sse += (a - b).powi(2);
-        sst += (a - mean).powi(2);
-    }
-    1.0 - (sse / sst.max(1e-300)).sqrt()
 }
 
 /// The share of the reference's peak hand force below which a sample's force error is shown
@@ -178,7 +255,8 @@ pub struct Comparison {
     pub compared_elements: usize,
     /// Signed relative error of the peak (1 ms averaged) hand force.
     pub peak_force_error: f64,
-    /// Signed relative error of the ROI's largest maximum principal stress.
+    /// Signed relative error of the largest maximum principal stress over the compared ROI
+    /// elements.
     pub peak_stress_error: f64,
 }
 
@@ -217,7 +295,8 @@ impl Comparison {
 
 /// Width H of the recovered stress (m): the Gaussian average `sum_j w_j s_j / sum_j w_j`, `w_j =
 /// exp(-|x - x_j|^2 / H^2)` over the ROI elements j, the surrogate's `--recover` target
-/// (`surrogate::recovery`), with which 2.5 and 3 mm meshes agree to Fit 0.82-0.87 where the
+/// (`surrogate::recovery`, whose weights are those of a field on its own centroids; here one
+/// mesh's field is read at another's centroids), with which 2.5 and 3 mm meshes agree to Fit 0.82-0.87 where the
 /// element stresses agree to 0.63-0.69 (docs/campaigns.md).
 pub const RECOVERY_WIDTH: f64 = 5e-3;
 
@@ -233,46 +312,60 @@ fn recovered(xs: &[[f64; 3]], s: &[f64], c: &[f64; 3]) -> f64 {
     num / den.max(1e-300)
 }
 
-/// The reference ROI elements inside the run's ROI patch (within the largest distance of a
-/// run ROI centroid from their mean): a finer mesh's 377 ROI elements cover less of the
+/// The reference ROI elements inside the run's ROI patch: those whose nearest run ROI
+/// centroid lies within the run's own spacing (the median distance from a run ROI element to
+/// its nearest neighbour, about a voxel). A finer mesh's 377 ROI elements cover less of the
 /// liver's surface, and a reference element beyond them has no counterpart.
 fn covered(run: &RunRecord, reference: &RunRecord) -> Vec<usize> {
-    let n = run.roi_centroids.len().max(1) as f64;
-    let mut m = [0.0; 3];
-    for x in &run.roi_centroids {
-        for k in 0..3 {
-            m[k] += x[k] / n;
-        }
-    }
-    let dist = |x: &[f64; 3]| (0..3).map(|k| (x[k] - m[k]).powi(2)).sum::<f64>().sqrt();
-    let r = run.roi_centroids.iter().map(dist).fold(0.0, f64::max);
+    let xs = &run.roi_centroids;
+    let mut nn: Vec<f64> = (0..xs.len())
+        .map(|i| {
+            let others: Vec<[f64; 3]> = xs
+                .iter()
+                .enumerate()
+                .filter(|&(j, _)| j != i)
+                .map(|(_, x)| *x)
+                .collect();
+            nearest(&others, &xs[i]).1
+        })
+        .collect();
+    nn.sort_by(f64::total_cmp);
+    let spacing = nn.get(nn.len() / 2).copied().unwrap_or(0.0);
     (0..reference.roi_centroids.len())
-        .filter(|&i| dist(&reference.roi_centroids[i]) <= r * (1.0 + 1e-9))
+        .filter(|&i| nearest(xs, &reference.roi_centroids[i]).1 <= spacing * (1.0 + 1e-9))
         .collect()
 }
 
-/// Compare `run` with `reference` (both completed, same location and sample times).
-pub fn compare(run: &RunRecord, reference: &RunRecord) -> Comparison {
+/// Compare `run` with `reference` (both completed at the same location); an error says why
+/// they cannot be compared (shapes, sample times).
+pub fn compare(run: &RunRecord, reference: &RunRecord) -> Result<Comparison, String> {
+    for (who, r) in [("run", run), ("reference", reference)] {
+        if let Some(e) = r.shape_error() {
+            return Err(format!("the {who}'s record: {e}"));
+        }
+    }
+    let same_times = run.sample_times.len() == reference.sample_times.len()
+        && run
+            .sample_times
+            .iter()
+            .zip(&reference.sample_times)
+            .all(|(a, b)| (a - b).abs() < 1e-4);
+    if !same_times {
+        return Err("its sample times are not the reference's".into());
+    }
     let rel = |a: f64, b: f64| (a - b) / b;
     let inside = covered(run, reference);
+    if inside.is_empty() {
+        return Err("its ROI covers none of the reference's".into());
+    }
     // Each covered reference ROI element's nearest ROI element of the run (the same one on
     // one mesh).
     let map: Vec<usize> = inside
         .iter()
-        .map(|&i| {
-            let c = &reference.roi_centroids[i];
-            let d2 = |q: &[f64; 3]| (0..3).map(|k| (q[k] - c[k]).powi(2)).sum::<f64>();
-            (0..run.roi_centroids.len())
-                .min_by(|&a, &b| d2(&run.roi_centroids[a]).total_cmp(&d2(&run.roi_centroids[b])))
-                .unwrap_or(0)
-        })
+        .map(|&i| nearest(&run.roi_centroids, &reference.roi_centroids[i]).0)
         .collect();
-    let n = run.roi_stress.len().min(reference.roi_stress.len());
-    let at = |row: &[f64], idx: &[usize]| -> Vec<f64> {
-        idx.iter()
-            .map(|&m| row.get(m).copied().unwrap_or(f64::NAN))
-            .collect()
-    };
+    let n = run.roi_stress.len();
+    let at = |row: &[f64], idx: &[usize]| -> Vec<f64> { idx.iter().map(|&m| row[m]).collect() };
     let ref_raw: Vec<Vec<f64>> = (0..n)
         .map(|k| at(&reference.roi_stress[k], &inside))
         .collect();
@@ -300,7 +393,7 @@ pub fn compare(run: &RunRecord, reference: &RunRecord) -> Comparison {
             .copied()
             .fold(f64::NEG_INFINITY, f64::max)
     };
-    Comparison {
+    Ok(Comparison {
         force_errors: run
             .force_at_samples
             .iter()
@@ -318,8 +411,8 @@ pub fn compare(run: &RunRecord, reference: &RunRecord) -> Comparison {
         pooled_recovered_fit: fit(&flat(&ref_rec), &flat(&run_rec)),
         compared_elements: inside.len(),
         peak_force_error: rel(run.peak_force, reference.peak_force),
-        peak_stress_error: rel(peak(&run.roi_stress), peak(&reference.roi_stress)),
-    }
+        peak_stress_error: rel(peak(&run_raw), peak(&ref_raw)),
+    })
 }
 
 #[cfg(test)]
@@ -328,6 +421,7 @@ mod tests {
 
     fn record(force: Vec<f64>, centroids: Vec<[f64; 3]>, stress: Vec<Vec<f64>>) -> RunRecord {
         RunRecord {
+            format: FORMAT,
             location: "A".into(),
             knob: "k".into(),
             setting: "s".into(),
@@ -339,10 +433,10 @@ mod tests {
             threads: 1,
             added_mass_percent: 0.0,
             max_energy_error: 0.0,
-            sample_times: vec![0.01, 0.02],
+            sample_times: (0..force.len()).map(|k| 0.01 * (k + 1) as f64).collect(),
             peak_force: force.iter().copied().fold(0.0, f64::max),
             force_at_samples: force,
-            roi_elements: Vec::new(),
+            roi_elements: (0..centroids.len() as u32).collect(),
             roi_centroids: centroids,
             roi_stress: stress,
             scene: String::new(),
@@ -354,7 +448,7 @@ mod tests {
         let c = vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [2.0, 0.0, 0.0]];
         let s = vec![vec![1.0, 2.0, 3.0], vec![2.0, 4.0, 6.0]];
         let r = record(vec![10.0, 20.0], c.clone(), s.clone());
-        let same = compare(&r, &r);
+        let same = compare(&r, &r).unwrap();
         assert_eq!(same.pooled_fit, 1.0);
         assert_eq!(same.worst_force_error(), 0.0);
         // +1 on every element at the first sample: sse = 3, sst = 2, Fit = 1 - sqrt(3/2).
@@ -363,7 +457,7 @@ mod tests {
             c,
             vec![vec![2.0, 3.0, 4.0], vec![2.0, 4.0, 6.0]],
         );
-        let d = compare(&shifted, &r);
+        let d = compare(&shifted, &r).unwrap();
         assert!((d.fits[0] - (1.0 - 1.5f64.sqrt())).abs() < 1e-12);
         assert_eq!(d.fits[1], 1.0);
         assert!((d.force_errors[0] - 0.1).abs() < 1e-12);
@@ -391,11 +485,11 @@ mod tests {
             ],
             vec![vec![1.0, 7.0, 7.0, 3.0]],
         );
-        let d = compare(&fine, &r);
+        let d = compare(&fine, &r).unwrap();
         assert_eq!(d.compared_elements, 2);
         assert_eq!(d.fits[0], 1.0);
-        // its peak is the finer mesh's own: 7 against 3
-        assert!((d.peak_stress_error - 4.0 / 3.0).abs() < 1e-12);
+        // peaks over the compared elements: the finer mesh's 7s lie between them
+        assert_eq!(d.peak_stress_error, 0.0);
     }
 
     #[test]
@@ -410,7 +504,7 @@ mod tests {
             vec![[-0.1, 0.0, 0.0], [0.1, 0.0, 0.0]],
             vec![vec![1.0, 1.0]],
         );
-        assert_eq!(compare(&small, &r).compared_elements, 1);
+        assert_eq!(compare(&small, &r).unwrap().compared_elements, 1);
     }
 
     #[test]
@@ -424,8 +518,32 @@ mod tests {
     }
 
     #[test]
+    fn what_cannot_be_compared_says_why() {
+        let c = vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0]];
+        let r = record(
+            vec![1.0, 2.0],
+            c.clone(),
+            vec![vec![1.0, 2.0], vec![2.0, 4.0]],
+        );
+        let mut late = r.clone();
+        late.sample_times[1] += 1e-3;
+        assert!(compare(&late, &r).unwrap_err().contains("sample times"));
+        let mut short = r.clone();
+        short.roi_stress[1].pop();
+        assert!(compare(&short, &r).unwrap_err().contains("stress row"));
+        let far = record(
+            vec![1.0, 2.0],
+            vec![[5.0, 0.0, 0.0], [6.0, 0.0, 0.0]],
+            r.roi_stress.clone(),
+        );
+        assert!(compare(&far, &r).unwrap_err().contains("covers none"));
+        // a constant reference field has no Fit
+        assert!(fit(&[2.0, 2.0], &[2.0, 2.0]).is_nan());
+    }
+
+    #[test]
     fn slugs_are_file_names() {
-        let v = Variant::new("bulk ratio", "K/G <= 1000", PalpationSetup::default());
+        let v = StudySetting::new("bulk ratio", "K/G <= 1000", PalpationSetup::default());
         assert_eq!(v.slug(), "bulk_ratio_K_G_1000");
     }
 }
