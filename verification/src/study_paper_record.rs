@@ -174,21 +174,24 @@ impl RunRecord {
             .map(|&t| t.min(end - half))
             .collect();
         self.force_at_samples = moving_average_at(&d.time, &d.force, FORCE_FILTER, &at);
-        self.peak_force = moving_average(&d.time, &d.force, FORCE_FILTER)
+        let peak = moving_average(&d.time, &d.force, FORCE_FILTER)
             .into_iter()
             .zip(&d.time)
             .filter(|(_, &t)| t >= half && t <= end - half)
-            .map(|(f, _)| f)
-            .fold(f64::NEG_INFINITY, |m, f| {
-                if f.is_nan() || m.is_nan() {
-                    f64::NAN
-                } else {
-                    m.max(f)
-                }
-            });
+            .map(|(f, _)| f);
+        self.peak_force = fold_nan(peak, f64::NEG_INFINITY, f64::max);
         self.roi_elements = p.elements.clone();
         self.roi_centroids = d.centroids.clone();
         self.roi_stress = keep.iter().map(|&k| p.stress[k].clone()).collect();
+    }
+
+    /// Whether each sample's force error counts ([`Comparison::force_counted`]): the force there
+    /// is at least [`FORCE_COUNTED`] of the peak.
+    pub fn counted_samples(&self) -> Vec<bool> {
+        self.force_at_samples
+            .iter()
+            .map(|&f| f >= FORCE_COUNTED * self.peak_force)
+            .collect()
     }
 
     /// Why the record's samples cannot be compared (inconsistent shapes), if they cannot.
@@ -216,6 +219,17 @@ impl RunRecord {
             .any(|row| row.len() != r)
             .then(|| format!("a stress row without {r} values"))
     }
+}
+
+/// Fold that keeps a NaN (unlike `f64::max` and `f64::min` alone).
+pub fn fold_nan(xs: impl Iterator<Item = f64>, start: f64, pick: fn(f64, f64) -> f64) -> f64 {
+    xs.fold(start, |m, x| {
+        if m.is_nan() || x.is_nan() {
+            f64::NAN
+        } else {
+            pick(m, x)
+        }
+    })
 }
 
 /// Paper eq. 5: the Fit of `yhat` to the reference values `y` ([`surrogate::compute_fit`]:
@@ -318,15 +332,14 @@ fn recovered(xs: &[[f64; 3]], s: &[f64], c: &[f64; 3]) -> f64 {
 /// liver's surface, and a reference element beyond them has no counterpart.
 fn covered(run: &RunRecord, reference: &RunRecord) -> Vec<usize> {
     let xs = &run.roi_centroids;
+    let dist = |a: &[f64; 3], b: &[f64; 3]| (0..3).map(|k| (a[k] - b[k]).powi(2)).sum::<f64>();
     let mut nn: Vec<f64> = (0..xs.len())
         .map(|i| {
-            let others: Vec<[f64; 3]> = xs
-                .iter()
-                .enumerate()
-                .filter(|&(j, _)| j != i)
-                .map(|(_, x)| *x)
-                .collect();
-            nearest(&others, &xs[i]).1
+            let d2 = (0..xs.len())
+                .filter(|&j| j != i)
+                .map(|j| dist(&xs[i], &xs[j]))
+                .fold(f64::INFINITY, f64::min);
+            d2.sqrt()
         })
         .collect();
     nn.sort_by(f64::total_cmp);
@@ -400,11 +413,7 @@ pub fn compare(run: &RunRecord, reference: &RunRecord) -> Result<Comparison, Str
             .zip(&reference.force_at_samples)
             .map(|(&a, &b)| rel(a, b))
             .collect(),
-        force_counted: reference
-            .force_at_samples
-            .iter()
-            .map(|&f| f >= FORCE_COUNTED * reference.peak_force)
-            .collect(),
+        force_counted: reference.counted_samples(),
         fits,
         pooled_fit: fit(&flat(&ref_raw), &flat(&run_raw)),
         recovered_fits,

@@ -10,7 +10,7 @@
 //! not yet measured at every location that has a reference.
 
 use crate::study_paper::{BASE, REFERENCE};
-use crate::study_paper_record::{compare, Comparison, RunRecord};
+use crate::study_paper_record::{compare, fold_nan, Comparison, RunRecord};
 use std::fmt::Write;
 use std::path::Path;
 
@@ -61,17 +61,6 @@ impl SettingSummary {
 /// The error budgets the report checks: (|hand force error| at most, per-sample Fit at least).
 pub const BUDGETS: [(f64, f64); 4] = [(0.02, 0.98), (0.05, 0.95), (0.10, 0.90), (0.15, 0.80)];
 
-/// Fold that keeps a NaN (unlike `f64::max` and `f64::min`).
-fn fold_nan(xs: impl Iterator<Item = f64>, start: f64, pick: fn(f64, f64) -> f64) -> f64 {
-    xs.fold(start, |m, x| {
-        if m.is_nan() || x.is_nan() {
-            f64::NAN
-        } else {
-            pick(m, x)
-        }
-    })
-}
-
 /// The completed reference at `location`, if any.
 fn reference_at<'a>(records: &'a [RunRecord], location: &str) -> Option<&'a RunRecord> {
     records
@@ -100,9 +89,15 @@ pub fn comparisons(records: &[RunRecord]) -> Vec<(&RunRecord, Result<Comparison,
 
 /// Locations with a completed reference, in record order.
 fn referenced_locations(records: &[RunRecord]) -> Vec<String> {
+    locations_where(records, true)
+}
+
+/// The locations of the records, in record order, whose reference has (`true`) or has not
+/// completed.
+fn locations_where(records: &[RunRecord], referenced: bool) -> Vec<String> {
     let mut v: Vec<String> = Vec::new();
     for r in records {
-        if reference_at(records, &r.location).is_some() && !v.contains(&r.location) {
+        if reference_at(records, &r.location).is_some() == referenced && !v.contains(&r.location) {
             v.push(r.location.clone());
         }
     }
@@ -310,13 +305,7 @@ fn pct(x: f64) -> String {
 
 /// Locations with records but no completed reference.
 pub fn pending_references(records: &[RunRecord]) -> Vec<String> {
-    let mut v: Vec<String> = Vec::new();
-    for r in records {
-        if reference_at(records, &r.location).is_none() && !v.contains(&r.location) {
-            v.push(r.location.clone());
-        }
-    }
-    v
+    locations_where(records, false)
 }
 
 /// From when on the force errors count: the earliest and latest first counted sample time
@@ -326,9 +315,8 @@ fn counted_from(records: &[RunRecord]) -> Option<(f64, f64)> {
         .iter()
         .filter_map(|l| {
             let q = reference_at(records, l)?;
-            let c = compare(q, q).ok()?;
-            let k = c.force_counted.iter().position(|&x| x)?;
-            Some(1e3 * q.sample_times[k])
+            let k = q.counted_samples().iter().position(|&x| x)?;
+            Some(1e3 * q.sample_times.get(k)?)
         })
         .collect();
     (!firsts.is_empty()).then(|| {
