@@ -12,24 +12,23 @@
 //! SSE2 or NEON elsewhere); both perform the same IEEE operations in the same order, so results
 //! do not depend on which runs. `PALPA_SIMD=baseline` forces the baseline path.
 //!
-//! Assembly: the chunks of every group run in the passes of the model's [`Schedule`] (no two
-//! chunks of a pass share a node). The chunks of a pass run in parallel, each adding its
-//! elements' nodal forces into the nodal force array as it goes (element by element, lane by
-//! lane); the passes run one after the other. No two threads write the same node at once, and
-//! every node receives its contributions in the same order (pass, then element order) whatever
-//! the thread count, so results are bitwise identical on 1 or N threads. This replaced a
-//! per-element force buffer summed by a node-to-element gather table, which moved 384 bytes per
-//! element and cycle more and cost about a third of the step on the 100k-element blocks of
-//! `palpa bench` (the gather's loads were cache misses 512 bytes apart). Chunk partial results
-//! (minimum step, energy rates: one [`ElementTotals`] per chunk) are reduced serially, group by
-//! group in chunk order, and inside a chunk element by element in element order, both by
-//! [`ElementTotals::combine`], for the same reason.
+//! Assembly: the elements of a group are cut into chunks of [`CHUNK`], and the chunks are
+//! coloured so that no two chunks of one colour share a node ([`crate::model::Group::colours`]).
+//! The chunks of one colour run in parallel, each adding its elements' nodal forces into the
+//! nodal force array as it goes (element by element, lane by lane); the colours run one after
+//! the other. No two threads write the same node at once, and every node receives its
+//! contributions in the same order (colour, then element order) whatever the thread count, so
+//! results are bitwise identical on 1 or N threads. This replaced a per-element force buffer
+//! summed by a node-to-element gather table, which moved 384 bytes per element and cycle more and
+//! cost about a third of the step on the 100k-element blocks of `palpa bench` (the gather's loads
+//! were cache misses 512 bytes apart). Chunk partial results (minimum step, energy rates: one
+//! [`ElementTotals`] per chunk) are reduced serially in chunk order, and inside a chunk element
+//! by element in element order, both by [`ElementTotals::combine`], for the same reason.
 
 use crate::element::physical::PhysicalRef;
 use crate::element::precision::{NarrowRef, Precision, Refs};
 use crate::element::{fault_error, full, one_point, ElementOut, Formulation, Nodal, StepInput};
 use crate::model::{ChunkOut, ElementTotals, Group, Part, CHUNK};
-use crate::schedule::Schedule;
 use material::real::{F64x8, Mask, Real, LANES};
 use material::real_f32::F32x8;
 use material::{with_law, Law};
@@ -89,12 +88,11 @@ struct Batch<'a> {
 
 /// Run the element loop: set `force` (one entry per node) to the sum of the element forces and
 /// `stress` (if requested, indexed by global element id) to the Cauchy stress; return totals or
-/// the first failing element (in group order, then chunk order).
+/// the first failing element.
 #[allow(clippy::too_many_arguments)]
 pub fn element_loop(
     parts: &[Part],
     groups: &mut [Group],
-    schedule: &Schedule,
     x_ref: &[[f64; 3]],
     u: &[[f64; 3]],
     v: &[[f64; 3]],
@@ -113,13 +111,6 @@ pub fn element_loop(
         groups.iter().all(|g| g.max_node < n_nodes),
         "element_loop: an element refers to a node beyond x_ref"
     );
-    assert!(
-        schedule.passes.iter().flatten().all(|c| {
-            let g = groups.get(c.group as usize);
-            g.is_some_and(|g| (c.chunk as usize) < g.chunks.len())
-        }),
-        "element_loop: the schedule names a chunk the groups do not have"
-    );
     if let Some(s) = &stress {
         // A group's global ids ascend (the model collects them in mesh order).
         let ne = groups.iter().filter_map(|g| g.elements.last()).max();
@@ -131,47 +122,37 @@ pub fn element_loop(
     let stress_ptr = stress.map(|s| Shared(s.as_mut_ptr()));
     force.par_chunks_mut(4096).for_each(|c| c.fill([0.0; 3]));
     let force_ptr = Shared(force.as_mut_ptr());
-    // Each group's chunk results and history are written through raw pointers taken here, by
-    // the one chunk that owns each entry.
-    let mut outs = Vec::with_capacity(groups.len());
+    let mut tot = ElementTotals::EMPTY;
     for g in groups.iter_mut() {
+        let part = &parts[g.part];
+        let n = g.elements.len();
         if input.precision == Precision::F32 && g.narrow.is_none() {
             g.narrow = Some(Box::new(NarrowRef::new(&g.refs())));
         }
-        outs.push((
-            Shared(g.chunks.as_mut_ptr()),
-            Shared(g.history.as_mut_ptr()),
-        ));
-    }
-    {
-        let groups: &[Group] = groups;
-        let batch = |gi: usize| {
-            let g = &groups[gi];
-            Batch {
-                form: parts[g.part].formulation,
-                group: g,
-                x_ref,
-                u,
-                v,
-                input,
-                hist: outs[gi].1,
-                stress: stress_ptr,
-                force: force_ptr,
-            }
+        let mut chunks = std::mem::take(&mut g.chunks);
+        let chunk_ptr = Shared(chunks.as_mut_ptr());
+        let hist = Shared(g.history.as_mut_ptr());
+        let batch = Batch {
+            form: part.formulation,
+            group: g,
+            x_ref,
+            u,
+            v,
+            input,
+            hist,
+            stress: stress_ptr,
+            force: force_ptr,
         };
-        for pass in &schedule.passes {
-            pass.par_iter().for_each(|c| {
-                let (gi, ci) = (c.group as usize, c.chunk as usize);
-                let b = batch(gi);
-                let out = with_law!(&parts[b.group.part].material, l => run_chunk(l, &b, ci));
-                // SAFETY: each chunk appears once in the schedule.
-                unsafe { outs[gi].0.slice(ci, 1)[0] = out };
-            });
-        }
-    }
-    let mut tot = ElementTotals::EMPTY;
-    for g in groups.iter_mut() {
-        let n = g.elements.len();
+        with_law!(&part.material, l => {
+            for colour in &g.colours {
+                colour.par_iter().for_each(|&ci| {
+                    let out = run_chunk(l, &batch, ci as usize);
+                    // SAFETY: each chunk index appears once in the colouring.
+                    unsafe { chunk_ptr.slice(ci as usize, 1)[0] = out };
+                });
+            }
+        });
+        g.chunks = chunks;
         // the run's totals chunk by chunk in chunk order (bitwise), the group's beside
         let mut group = ElementTotals::EMPTY;
         for ch in &g.chunks {

@@ -14,7 +14,6 @@ pub mod mesh;
 pub mod mesh_io;
 pub mod model;
 pub mod output;
-pub mod schedule;
 pub mod simulation;
 
 pub use mesh::Mesh;

@@ -1,6 +1,6 @@
 //! The assembled model: element groups in struct-of-arrays form, lumped masses, selective mass
-//! scaling, and the element loop's schedule ([`crate::schedule`]) that lets it add its forces into
-//! the nodal array in parallel without a race.
+//! scaling, and the chunk colouring that lets the element loop add its forces into the nodal array
+//! in parallel without a race.
 //!
 //! Elements are grouped by part (one law and one formulation per group). Each group stores
 //! its reference data contiguously: connectivity, mean or centre gradients, volumes,
@@ -22,7 +22,6 @@ use crate::element::{
 };
 use crate::hex::{element_geometry, hourglass_gamma, ElementGeometry};
 use crate::mesh::Mesh;
-use crate::schedule::Schedule;
 use material::real::{F64x8, Real, LANES};
 use material::Material;
 use std::fmt;
@@ -232,6 +231,11 @@ pub struct Group {
     pub history: Vec<F64x8>,
     /// Density scale factors from mass scaling (empty if none).
     pub density_scale: Vec<f64>,
+    /// The group's chunks ([`CHUNK`] elements each) by colour: no two chunks of one colour share
+    /// a node, so the chunks of a colour add their element forces straight into the nodal
+    /// force array in parallel without a race, and every node receives its contributions in
+    /// the same order (colour, then element order within its chunk) on any thread count.
+    pub(crate) colours: Vec<Vec<u32>>,
     /// Largest node index of the group's elements, found once when the model is built: the
     /// element loop checks it against the nodal arrays it is given (its kernels index them
     /// without bounds checks).
@@ -276,9 +280,17 @@ impl GroupHourglass {
     }
 }
 
-pub use crate::schedule::CHUNK;
+/// Elements per parallel chunk (a multiple of [`LANES`]). Fixed, so partial sums are formed in
+/// the same order for any thread count (bitwise determinism).
+pub const CHUNK: usize = 512;
 
 impl Group {
+    /// The element loop's colouring (see [`Group::colours`]): the number of colours and the
+    /// fewest chunks any colour has (the parallelism the element loop can use).
+    pub fn colouring(&self) -> (usize, usize) {
+        let fewest = self.colours.iter().map(|c| c.len()).min().unwrap_or(0);
+        (self.colours.len(), fewest)
+    }
     /// Number of batches of [`LANES`] elements (the last one padded with copies of the group's
     /// last element, whose results are discarded).
     pub fn batches(&self) -> usize {
@@ -310,6 +322,48 @@ impl Group {
             .map(|(le, ip)| self.history_value(le, ip, k, history_len))
             .collect()
     }
+}
+
+/// Colour the chunks of a group (elements in chunks of [`CHUNK`], in order) so that no two chunks
+/// of one colour share a node: greedy, each chunk taking the lowest colour none of the earlier
+/// chunks it shares a node with has. A mesh numbered for locality (slabs of elements) needs a few
+/// colours; each colour lists its chunks in ascending order.
+pub(crate) fn colour_chunks(conn: &[[u32; 8]], n_nodes: usize) -> Vec<Vec<u32>> {
+    let n_chunks = conn.len().div_ceil(CHUNK);
+    // For each node, the chunks (ascending) that touch it.
+    let mut node_chunks: Vec<Vec<u32>> = vec![Vec::new(); n_nodes];
+    for (e, c) in conn.iter().enumerate() {
+        let ci = (e / CHUNK) as u32;
+        for &n in c {
+            let list = &mut node_chunks[n as usize];
+            if list.last() != Some(&ci) {
+                list.push(ci);
+            }
+        }
+    }
+    let mut colour = vec![u32::MAX; n_chunks];
+    let mut colours: Vec<Vec<u32>> = Vec::new();
+    let mut taken: Vec<bool> = Vec::new();
+    for ci in 0..n_chunks {
+        taken.iter_mut().for_each(|t| *t = false);
+        for c in &conn[ci * CHUNK..((ci + 1) * CHUNK).min(conn.len())] {
+            for &n in c {
+                for &other in &node_chunks[n as usize] {
+                    if (other as usize) < ci {
+                        taken[colour[other as usize] as usize] = true;
+                    }
+                }
+            }
+        }
+        let k = taken.iter().position(|t| !t).unwrap_or(taken.len());
+        if k == colours.len() {
+            colours.push(Vec::new());
+            taken.push(false);
+        }
+        colour[ci] = k as u32;
+        colours[k].push(ci as u32);
+    }
+    colours
 }
 
 /// Lane vectors of per-element data, batch by batch; lanes past the end repeat the last element.
@@ -456,8 +510,6 @@ pub struct Model {
     pub parts: Vec<Part>,
     /// Element groups.
     pub groups: Vec<Group>,
-    /// The element loop's passes over the groups' chunks.
-    pub schedule: Schedule,
     /// Nodal mass including mass scaling (kg).
     pub mass: Vec<f64>,
     /// Per-part mass report.
@@ -574,13 +626,10 @@ impl Model {
                 "node {n} belongs to no element (zero mass); remove it"
             )));
         }
-        let conns: Vec<&[[u32; 8]]> = groups.iter().map(|g| g.conn.as_slice()).collect();
-        let schedule = Schedule::colour(&conns, mesh.nodes.len());
         Ok(Model {
             mesh,
             parts,
             groups,
-            schedule,
             mass,
             part_mass,
             initial_dt,
@@ -731,6 +780,7 @@ impl Builder<'_> {
         if stride > 0 {
             init_history(&mut g, law, stride);
         }
+        g.colours = colour_chunks(&g.conn, self.mesh.nodes.len());
         g.max_node = g.conn.iter().flatten().copied().max().unwrap_or(0) as usize;
         Ok(g)
     }
@@ -806,6 +856,7 @@ fn empty_group(part: usize, elements: Vec<u32>, stride: usize) -> Group {
         history_stride: stride,
         history: vec![F64x8::splat(0.0); stride * n.div_ceil(LANES)],
         density_scale: Vec::new(),
+        colours: Vec::new(),
         max_node: 0,
         hourglass: GroupHourglass::default(),
         chunks: vec![ChunkOut::default(); n.div_ceil(CHUNK)],
@@ -939,5 +990,75 @@ impl ElementData {
         g.gp_weight = batched(&self.gp_weight, |e| {
             std::array::from_fn(|gp| lanes(|l| e[l][gp]))
         });
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Connectivity of an nx x ny x nz block of hexahedra (the box generator's, elements in
+    /// x-fastest order) and its node count.
+    fn block(nx: u32, ny: u32, nz: u32) -> (Vec<[u32; 8]>, usize) {
+        let spec = crate::generate::BoxSpec {
+            divisions: [nx as usize, ny as usize, nz as usize],
+            ..Default::default()
+        };
+        let mesh = crate::generate::box_mesh(&spec, "block").unwrap();
+        (mesh.elements, mesh.nodes.len())
+    }
+
+    /// Every chunk in exactly one colour, and no two chunks of a colour sharing a node.
+    fn assert_valid(conn: &[[u32; 8]], n_nodes: usize, colours: &[Vec<u32>]) {
+        let n_chunks = conn.len().div_ceil(CHUNK);
+        let mut seen = vec![0; n_chunks];
+        for colour in colours {
+            let mut owner = vec![u32::MAX; n_nodes];
+            for &ci in colour {
+                seen[ci as usize] += 1;
+                let c = ci as usize;
+                for e in &conn[c * CHUNK..((c + 1) * CHUNK).min(conn.len())] {
+                    for &n in e {
+                        let o = &mut owner[n as usize];
+                        assert!(
+                            *o == u32::MAX || *o == ci,
+                            "chunks {} and {ci} share node {n}",
+                            *o
+                        );
+                        *o = ci;
+                    }
+                }
+            }
+            assert!(
+                colour.windows(2).all(|w| w[0] < w[1]),
+                "chunks in ascending order"
+            );
+        }
+        assert!(seen.iter().all(|&s| s == 1), "every chunk coloured once");
+    }
+
+    #[test]
+    fn colouring_of_an_ordered_block_is_race_free_and_parallel() {
+        let (conn, nn) = block(50, 50, 40);
+        let colours = colour_chunks(&conn, nn);
+        assert_valid(&conn, nn, &colours);
+        // Slabs of 512 elements in a 50 x 50 plane: a handful of colours, each with many chunks.
+        assert!(colours.len() <= 6, "{} colours", colours.len());
+        assert!(colours.iter().all(|c| c.len() >= 20));
+    }
+
+    #[test]
+    fn colouring_of_a_shuffled_block_is_still_race_free() {
+        let (mut conn, nn) = block(20, 20, 20);
+        // A fixed pseudo-random permutation of the elements (xorshift).
+        let mut s = 0x9e37_79b9_7f4a_7c15u64;
+        for i in (1..conn.len()).rev() {
+            s ^= s << 13;
+            s ^= s >> 7;
+            s ^= s << 17;
+            conn.swap(i, (s % (i as u64 + 1)) as usize);
+        }
+        let colours = colour_chunks(&conn, nn);
+        assert_valid(&conn, nn, &colours);
     }
 }

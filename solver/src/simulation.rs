@@ -447,14 +447,12 @@ impl Simulation {
         let Model {
             parts,
             groups,
-            schedule,
             mesh,
             ..
         } = &mut self.model;
         let r = element_loop(
             parts,
             groups,
-            schedule,
             &mesh.nodes,
             &self.u,
             &self.v,
@@ -1094,13 +1092,7 @@ impl NodalUpdate<'_> {
             let n = ci * NODE_CHUNK + k;
             let m = self.mass[n];
             for d in 0..3 {
-                let r = self.dof(n, d, m, &mut uc[k][d], &mut vc[k][d], s);
-                // A free degree of freedom's reaction stays at its initial zero: not writing it
-                // keeps the reactions' cache lines out of the update on most nodes (the update
-                // streams the nodal arrays from memory: the element loop has evicted them).
-                if self.dof_code[n * 3 + d] != 0 {
-                    rc[k][d] = r;
-                }
+                rc[k][d] = self.dof(n, d, m, &mut uc[k][d], &mut vc[k][d], s);
             }
         }
     }

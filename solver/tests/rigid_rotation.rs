@@ -64,16 +64,10 @@ fn max_stress_in(form: Formulation, precision: Precision, shift: [f64; 3]) -> f6
         want_stress: true,
         precision,
     };
-    let Model {
-        parts,
-        groups,
-        schedule,
-        ..
-    } = &mut model;
+    let Model { parts, groups, .. } = &mut model;
     element_loop(
         parts,
         groups,
-        schedule,
         &nodes,
         &u,
         &v,

@@ -147,18 +147,14 @@ pub fn check(path: &Path, deck: &DeckArgs, pilot: Pilot) -> Result<(), String> {
         bytes as f64 / 1048576.0,
         hist as f64 * 8.0 / 1048576.0
     );
-    let (chunks, passes, fewest) = m.schedule.summary();
-    let sizes: Vec<String> = m
-        .schedule
-        .passes
-        .iter()
-        .map(|p| p.len().to_string())
-        .collect();
-    println!(
-        "  element loop: {chunks} chunks of {} elements in {passes} passes of {} chunks (fewest {fewest}: the parallelism of the slowest pass)",
-        solver::model::CHUNK,
-        sizes.join(", "),
-    );
+    for g in &m.groups {
+        let (colours, fewest) = g.colouring();
+        println!(
+            "  element loop, part {}: {} chunks in {colours} colours (fewest {fewest} chunks per colour: the parallelism of its slowest pass)",
+            m.parts[g.part].name,
+            g.elements.len().div_ceil(solver::model::CHUNK),
+        );
+    }
     println!("  stages: {}", sim.active_stages().join(", "));
     let elements = mesh.elements.len();
     print_pilot(path, &scene, pilot, lsdyna::is_deck(path), elements);
