@@ -12,6 +12,7 @@
 //!   train` puts it beside the model, or, for a dataset without one, rebuilds the phantom from
 //!   the manifest and derives the same geometry; a merge carries it over;
 //! - the shipped profiles (scenes/campaign-quick.toml, scenes/campaign-paper.toml,
+//!   scenes/campaign-paper-fast.toml,
 //!   scenes/campaign-5mm.toml, scenes/campaign-fbar-8mm.toml, scenes/campaign-wide-grid.toml,
 //!   scenes/campaign-convergence-2.5mm.toml)
 //!   resolve on their phantoms (`--dry-run`), the default raster covers the ROI's plan extent,
@@ -311,6 +312,10 @@ fn shipped_profiles_resolve_and_bad_keys_are_named() {
     };
     assert_eq!(places(&five).len(), 28, "{five}");
     assert_eq!(places(&five), places(&paper));
+    // the default with the fast preset (data/campaign-paper-fast-3mm): the same runs
+    let fast = dry_run("campaign-paper-fast.toml");
+    assert!(fast.contains("voxel 3.0 mm"), "{fast}");
+    assert_eq!(places(&fast), places(&paper));
     let fbar = dry_run("campaign-fbar-8mm.toml");
     assert!(
         fbar.contains("28 runs (28 locations: 25 train, 3 test)") && fbar.contains("voxel 8.0 mm"),

@@ -8,10 +8,14 @@ use std::path::{Path, PathBuf};
 
 fn committed() -> Vec<PathBuf> {
     let data = Path::new(env!("CARGO_MANIFEST_DIR")).join("../data");
-    ["default-campaign-3mm", "convergence-2.5mm"]
-        .iter()
-        .map(|d| data.join(d))
-        .collect()
+    [
+        "default-campaign-3mm",
+        "campaign-paper-fast-3mm",
+        "convergence-2.5mm",
+    ]
+    .iter()
+    .map(|d| data.join(d))
+    .collect()
 }
 
 #[test]
@@ -53,19 +57,22 @@ fn a_plan_with_an_unknown_or_missing_key_is_an_error_naming_it() {
 }
 
 #[test]
-fn committed_dataset_reassembles_to_the_same_bytes() {
-    let dir = &committed()[0];
-    let plan = read_campaign_dir(dir).unwrap().plan().unwrap();
-    let labels: Vec<String> = plan.runs.iter().map(|r| r.label.clone()).collect();
-    let ds = assemble(&plan, &labels, |l| run_dir(dir, l)).unwrap();
-    let tmp = tempfile::tempdir().unwrap();
-    campaign::write_dataset(&ds, tmp.path()).unwrap();
-    for f in ["dataset.npz", "manifest.json", "dataset.json"] {
-        let a = std::fs::read(dir.join(f)).unwrap();
-        let b = std::fs::read(tmp.path().join(f)).unwrap();
-        assert!(
-            a == b,
-            "{f}: reassembled bytes differ from the committed file"
-        );
+fn committed_datasets_reassemble_to_the_same_bytes() {
+    // the two whole 28-run campaigns: the default and the same with the fast preset
+    for dir in &committed()[..2] {
+        let plan = read_campaign_dir(dir).unwrap().plan().unwrap();
+        let labels: Vec<String> = plan.runs.iter().map(|r| r.label.clone()).collect();
+        let ds = assemble(&plan, &labels, |l| run_dir(dir, l)).unwrap();
+        let tmp = tempfile::tempdir().unwrap();
+        campaign::write_dataset(&ds, tmp.path()).unwrap();
+        for f in ["dataset.npz", "manifest.json", "dataset.json"] {
+            let a = std::fs::read(dir.join(f)).unwrap();
+            let b = std::fs::read(tmp.path().join(f)).unwrap();
+            assert!(
+                a == b,
+                "{}/{f}: reassembled bytes differ from the committed file",
+                dir.display()
+            );
+        }
     }
 }
