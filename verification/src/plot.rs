@@ -50,6 +50,8 @@ pub fn draw(s: &Series, dir: &Path) -> Result<String, String> {
                 let mut chart = $chart;
                 chart
                     .configure_mesh()
+                    .x_label_formatter(&|v| tick(*v))
+                    .y_label_formatter(&|v| tick(*v))
                     .x_desc(s.axes.0.as_str())
                     .y_desc(s.axes.1.as_str())
                     .draw()
@@ -107,4 +109,10 @@ pub fn draw(s: &Series, dir: &Path) -> Result<String, String> {
     let png = picture::encode_png(&rgb, SIZE.0, SIZE.1).map_err(|x| e(&x))?;
     solver::output::atomic::write_atomic(&path, &png).map_err(|x| e(&x))?;
     Ok(name)
+}
+
+/// A tick label: the value rounded to six decimals and printed shortest, so that a log axis's
+/// 0.6 reads `0.6` and not `0.6000000000000001`.
+fn tick(v: f64) -> String {
+    format!("{}", (v * 1e6).round() / 1e6)
 }
