@@ -111,8 +111,9 @@ pub fn draw(s: &Series, dir: &Path) -> Result<String, String> {
     Ok(name)
 }
 
-/// A tick label: the value rounded to six decimals and printed shortest, so that a log axis's
-/// 0.6 reads `0.6` and not `0.6000000000000001`.
+/// A tick label: the value rounded to six significant digits and printed shortest, so that a
+/// log axis's 0.6 reads `0.6` and not `0.6000000000000001`, and a tick of 1e-7 stays 1e-7.
 fn tick(v: f64) -> String {
-    format!("{}", (v * 1e6).round() / 1e6)
+    let rounded: f64 = format!("{v:.5e}").parse().unwrap_or(v);
+    format!("{rounded}")
 }
