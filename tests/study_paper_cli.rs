@@ -172,3 +172,43 @@ fn bad_flags_and_empty_directories_are_named() {
     let err = String::from_utf8_lossy(&o.stderr);
     assert!(err.contains("no current study records"), "{err}");
 }
+
+/// The `fast` preset is the committed study's answer to the preset's own budget: the cheapest
+/// setting within hand force 10 % and per-sample ROI Fit 0.75 at A, B and C is the base with
+/// mass scaling to 1.3x the initial step, and the preset applied to the base runs that
+/// setting's scene (but for the added-mass limit, which only stops a run).
+#[test]
+fn the_fast_preset_is_the_studys_cheapest_setting_within_its_budget() {
+    use scene::palpation::Fidelity;
+    use verification::study_paper::{base_setup, plan};
+    use verification::study_paper_record::RunRecord;
+    use verification::study_paper_report::{cheapest_within, summarise, BUDGETS};
+    let records: Vec<RunRecord> = records()
+        .iter()
+        .map(|n| {
+            RunRecord::read(&committed().join("records").join(n))
+                .unwrap()
+                .unwrap()
+        })
+        .collect();
+    let rows = summarise(&records);
+    let (force, fit) = BUDGETS[3];
+    assert_eq!((force, fit), (0.10, 0.75));
+    let best = cheapest_within(&rows, force, fit).expect("a setting within the budget");
+    assert_eq!(
+        (best.knob.as_str(), best.setting.as_str()),
+        ("mass scaling", "1.3 x initial step")
+    );
+    assert_eq!(best.locations, ["A", "B", "C"]);
+    assert!(best.worst_force_error <= force && best.worst_fit >= fit);
+    for loc in ["A", "B", "C"] {
+        let row = plan(loc)
+            .into_iter()
+            .find(|s| s.knob == best.knob && s.setting == best.setting)
+            .unwrap();
+        let mut fast = base_setup(loc);
+        Fidelity::Fast.apply(&mut fast);
+        fast.mass_scaling_limit = row.setup.mass_scaling_limit;
+        assert_eq!(fast.scene_toml(), row.setup.scene_toml(), "{loc}");
+    }
+}

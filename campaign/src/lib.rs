@@ -62,7 +62,7 @@
 //! dt_factor = 0.9
 //! mass_scaling = "initial"         # selective mass scaling: initial (default) | "2 x initial" | "4 us" | "off"
 //! # mass_scaling_limit = 0.05
-//! # fidelity = "fast"             # 1pt-physical elements, K/G <= 5000, f32 kernels (docs/palpate.md)
+//! # fidelity = "fast"             # 1pt-physical, K/G <= 5000, f32, 1.3x mass scaling (docs/palpate.md)
 //! # precision = "f32"              # element kernels: f64 (default) | f32
 //! # max_bulk_ratio = 5000           # or the K/G cap alone
 //! vtk = false                      # VTK frames of every run (off: only the probe files)
@@ -163,6 +163,7 @@ mod tests {
         let scene = c.base.scene_toml();
         assert!(scene.contains("max_bulk_ratio = 5000.0"), "{scene}");
         assert!(scene.contains("precision = \"f32\""), "{scene}");
+        assert!(scene.contains("target_dt = \"1.3 x initial\""), "{scene}");
         let spec: CampaignSpec = toml::from_str("[solver]\nprecision = \"f32\"\n").unwrap();
         let c = spec.resolve().unwrap();
         assert!(c.base.scene_toml().contains("precision = \"f32\""));
@@ -172,6 +173,7 @@ mod tests {
             "element = \"full_fbar\"",
             "max_bulk_ratio = 100",
             "precision = \"f64\"",
+            "mass_scaling = \"initial\"",
         ] {
             let spec: CampaignSpec =
                 toml::from_str(&format!("[solver]\nfidelity = \"fast\"\n{extra}\n")).unwrap();

@@ -389,9 +389,10 @@ fn apply_solver(sv: &SolverSpec, base: &mut PalpationSetup) -> Result<(), String
             && (sv.element.is_some()
                 || sv.element_by_part.is_some()
                 || sv.max_bulk_ratio.is_some()
-                || sv.precision.is_some())
+                || sv.precision.is_some()
+                || sv.mass_scaling.is_some())
         {
-            return Err("solver.fidelity = \"fast\" sets the element, max_bulk_ratio and precision: give the preset or those keys".into());
+            return Err("solver.fidelity = \"fast\" sets the element, max_bulk_ratio, precision and mass_scaling: give the preset or those keys".into());
         }
         fid.apply(base);
         base.fidelity = fid;

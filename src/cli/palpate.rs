@@ -62,9 +62,9 @@ pub struct PalpateArgs {
     pub element: Option<String>,
     /// Selective mass scaling: `initial` (default: an element gets mass only when it shrinks
     /// below the initial stable step, so the step never falls; the added mass is reported),
-    /// `K x initial`, a time step such as `4us`, or `off`.
-    #[arg(long, default_value = "initial")]
-    pub mass_scaling: String,
+    /// `K x initial` (the fast preset's is `1.3x initial`), a time step such as `4us`, or `off`.
+    #[arg(long)]
+    pub mass_scaling: Option<String>,
     /// Time-step safety factor.
     #[arg(long, default_value_t = solver::simulation::DEFAULT_DT_FACTOR)]
     pub dt_factor: f64,
@@ -74,8 +74,9 @@ pub struct PalpateArgs {
     #[arg(long)]
     pub max_bulk_ratio: Option<f64>,
     /// Preset of the accuracy knobs: `standard` (the options as given) or `fast`
-    /// (1pt-physical elements, K/G capped at 5000 and f32 kernels: about a third of the steps; its measured
-    /// error against F-bar elements is printed with the summary and in docs/palpate.md).
+    /// (1pt-physical elements, K/G capped at 5000, f32 kernels and mass scaling to 1.3x the
+    /// initial step: about a quarter of the steps; its measured error against F-bar elements is
+    /// printed with the summary and in docs/palpate.md).
     #[arg(long, default_value = "standard")]
     pub fidelity: String,
     /// Number type of the element kernels: f64 or f32 (single-precision kernels; the laws,
@@ -133,8 +134,9 @@ impl PalpateArgs {
             .unwrap_or("one_point")
             .parse::<ElementChoice>()
             .map_err(|e| format!("--element: {e}"))?;
-        s.mass_scaling = solver::model::StepTarget::parse_switch(&self.mass_scaling)
-            .map_err(|e| format!("--mass-scaling: {e}"))?;
+        s.mass_scaling =
+            solver::model::StepTarget::parse_switch(self.mass_scaling.as_deref().unwrap_or("initial"))
+                .map_err(|e| format!("--mass-scaling: {e}"))?;
         s.dt_factor = self.dt_factor;
         s.max_bulk_ratio = self.max_bulk_ratio;
         let fidelity = self
@@ -142,10 +144,13 @@ impl PalpateArgs {
             .parse::<Fidelity>()
             .map_err(|e| format!("--fidelity: {e}"))?;
         if fidelity == Fidelity::Fast
-            && (self.element.is_some() || self.max_bulk_ratio.is_some() || self.precision.is_some())
+            && (self.element.is_some()
+                || self.max_bulk_ratio.is_some()
+                || self.precision.is_some()
+                || self.mass_scaling.is_some())
         {
             return Err(
-                "--fidelity fast sets --element, --max-bulk-ratio and --precision: give the preset or the options"
+                "--fidelity fast sets --element, --max-bulk-ratio, --precision and --mass-scaling: give the preset or the options"
                     .into(),
             );
         }

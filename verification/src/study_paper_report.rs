@@ -59,7 +59,16 @@ impl SettingSummary {
 }
 
 /// The error budgets the report checks: (|hand force error| at most, per-sample Fit at least).
-pub const BUDGETS: [(f64, f64); 4] = [(0.02, 0.98), (0.05, 0.95), (0.10, 0.90), (0.15, 0.80)];
+/// The fourth is the `fast` preset's ([`scene::palpation::Fidelity::Fast`] is its answer): a
+/// force error below the spread between the 4, 3 and 2.5 mm meshes (8-11 %), and a per-sample
+/// Fit well above the agreement of the ROI field between 3 and 2.5 mm voxels (0.28-0.67).
+pub const BUDGETS: [(f64, f64); 5] = [
+    (0.02, 0.98),
+    (0.05, 0.95),
+    (0.10, 0.90),
+    (0.10, 0.75),
+    (0.15, 0.80),
+];
 
 /// The completed reference at `location`, if any.
 fn reference_at<'a>(records: &'a [RunRecord], location: &str) -> Option<&'a RunRecord> {
@@ -509,7 +518,7 @@ pub fn plots(records: &[RunRecord], out: &Path) -> Result<Vec<String>, String> {
         }
         let series = crate::Series {
             plot: format!("pareto_3mm_{which}"),
-            title: format!("3 mm study: {label} against wall time, each knob from the fast preset"),
+            title: format!("3 mm study: {label} against wall time, each knob from the base"),
             axes: (
                 "wall time (s)".into(),
                 format!("{label} against the reference"),
