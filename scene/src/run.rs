@@ -427,6 +427,22 @@ pub fn next_output_time(next: f64, dt: f64, t: f64) -> f64 {
     }
 }
 
+/// [`run_scene`] on a worker thread of the global rayon pool (in place when the caller is one
+/// already), so that each of the step's parallel loops starts from a worker. Called from
+/// outside the pool, every loop hands its job to the pool and puts the calling thread to sleep
+/// until the job is done, several times per step (measured in docs/performance.md, "The time
+/// loop on a pool worker"). For one run per process, as `palpa palpate` and `palpa run` make:
+/// concurrent callers outside any pool would have their whole runs queued on the same workers,
+/// so they should each install their own pool, as the campaign does.
+pub fn run_scene_on_pool(
+    scene: &mut Scene,
+    out: &Path,
+    stop: &AtomicBool,
+    observer: impl FnMut(&Progress) + Send,
+) -> (RunSummary, Option<String>) {
+    rayon::scope(|_| run_scene(scene, out, stop, observer))
+}
+
 /// Run a scene, writing into `out`. `observer` is called every few steps and may update a
 /// progress bar. Returns the summary (also on failure, with the error in `status`) and the
 /// error if the run failed.
@@ -464,6 +480,9 @@ pub fn run_scene(
         if let Err(e) = p.flush().and_then(|_| pt.flush()) {
             error.get_or_insert(e);
         }
+    }
+    if let Err(e) = rec.series.finish() {
+        error.get_or_insert(e);
     }
     if let Some(e) = &error {
         status = RunStatus::Failed(e.clone());
@@ -568,12 +587,13 @@ impl Recorder {
     }
 
     /// The last history row (and frame) of a run that converged.
-    fn converged(&mut self, scene: &Scene) {
+    fn converged(&mut self, scene: &Scene) -> Result<(), String> {
         history_row(&scene.sim, &self.reactions, &mut self.row);
         self.history.push(&self.row);
         if self.write_vtk {
-            let _ = write_frame(scene, &mut self.series);
+            write_frame(scene, &mut self.series)?;
         }
+        Ok(())
     }
 
     /// The history row of the state that went unstable.
@@ -608,7 +628,7 @@ fn time_loop(
         }
         if let Some(r) = scene.sim.settings.relaxation {
             if scene.sim.step > 10 && scene.sim.residual < r.tolerance {
-                rec.converged(scene);
+                rec.converged(scene)?;
                 return Ok(RunStatus::Converged);
             }
         }

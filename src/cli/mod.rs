@@ -183,17 +183,24 @@ enum Command {
 }
 
 /// Set the global thread pool.
+/// Worker stacks of the global pool: `palpate` and `run` put their whole time loop on a worker
+/// ([`scene::run::run_scene_on_pool`]), so it gets the main thread's 8 MiB and more.
+const WORKER_STACK: usize = 16 << 20;
+
+/// Set the global thread pool: `threads` workers (default: one per core).
 pub fn set_threads(threads: Option<usize>) -> Result<(), String> {
-    if let Some(n) = threads {
-        if n == 0 {
-            return Err("--threads must be at least 1".into());
-        }
-        rayon::ThreadPoolBuilder::new()
-            .num_threads(n)
-            .build_global()
-            .map_err(|e| e.to_string())?;
+    if threads == Some(0) {
+        return Err("--threads must be at least 1".into());
     }
-    Ok(())
+    let built = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads.unwrap_or(0))
+        .stack_size(WORKER_STACK)
+        .build_global();
+    match (built, threads) {
+        // without --threads, a pool already built (by an earlier call) is as good
+        (Ok(()), _) | (Err(_), None) => Ok(()),
+        (Err(e), Some(_)) => Err(e.to_string()),
+    }
 }
 
 /// Run the chosen command.

@@ -4,7 +4,7 @@
 use super::input::{load, print_report, DeckArgs};
 use super::progress::{stop_flag, time_bar};
 use scene::run::RunStatus;
-use scene::run::{run_scene, RunSummary};
+use scene::run::{run_scene_on_pool, RunSummary};
 use scene::Scene;
 use std::path::Path;
 use std::time::Instant;
@@ -145,7 +145,7 @@ pub fn run_loaded(scene: &mut Scene, out: &Path, quiet: bool) -> (RunSummary, Op
     let stop = stop_flag();
     let pb = time_bar(scene.end_time, quiet);
     let wall = Instant::now();
-    let res = run_scene(scene, out, &stop, |p| {
+    let res = run_scene_on_pool(scene, out, &stop, |p| {
         pb.set_position((p.sim.time * 1e6) as u64);
         let rate = p.sim.step as f64 / wall.elapsed().as_secs_f64().max(1e-9);
         pb.set_message(format!(
