@@ -87,6 +87,8 @@ fn the_fast_preset_states_itself_and_the_bulk_moduli_it_ran() {
     );
     let scene = std::fs::read_to_string(out.join("scene.toml")).unwrap();
     assert!(scene.contains("hourglass = \"physical\""), "{scene}");
+    assert!(scene.contains("target_dt = \"1.3 x initial\""), "{scene}");
+    assert!(scene.contains("precision = \"f32\""), "{scene}");
     let s: serde_json::Value =
         serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
     let bulk = s["bulk_modulus"].as_array().unwrap();
@@ -98,6 +100,31 @@ fn the_fast_preset_states_itself_and_the_bulk_moduli_it_ran() {
     assert!((k / g - 5000.0).abs() < 1e-6, "K/G = {}", k / g);
     let ribs = bulk.iter().find(|b| b["part"] == "ribs").unwrap();
     assert_eq!(ribs["applied_pa"], ribs["original_pa"]);
+}
+
+/// An option for a knob the fast preset sets, given beside it, is refused before anything
+/// runs, naming the knobs, with a non-zero exit and no panic.
+#[test]
+fn a_knob_beside_the_fast_preset_is_refused() {
+    let dir = tempfile::tempdir().unwrap();
+    for extra in [
+        ["--mass-scaling", "off"],
+        ["--element", "full_fbar"],
+        ["--precision", "f64"],
+        ["--max-bulk-ratio", "100"],
+    ] {
+        let out = dir.path().join("x");
+        let o = coarse_press(&out, 2, &["--fidelity", "fast", extra[0], extra[1]]);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(!o.status.success(), "{extra:?}: accepted");
+        assert!(
+            err.contains("--fidelity fast sets")
+                && err.contains(extra[0])
+                && !err.contains("panicked"),
+            "{extra:?}: {err}"
+        );
+        assert!(!out.join("summary.json").exists(), "{extra:?} ran");
+    }
 }
 
 /// A `--max-bulk-ratio` that no material can have is refused before anything runs, naming the

@@ -153,15 +153,15 @@ pub struct SolverSpec {
     /// Time-step safety factor (default 0.75).
     pub dt_factor: Option<Number>,
     /// Selective mass scaling: `"initial"` (the default, as `palpa palpate`), `"<k> x
-    /// initial"`, a time step, or `"off"`.
+    /// initial"`, a time step, or `"off"`; not beside `fidelity = "fast"`, which sets it.
     pub mass_scaling: Option<String>,
     /// Largest added mass fraction (default 0.05).
     pub mass_scaling_limit: Option<Number>,
     /// Write VTK frames of every run (default false).
     pub vtk: Option<bool>,
     /// Preset of the accuracy knobs: `standard` (default) or `fast` (1pt-physical elements,
-    /// K/G capped at 5000, f32 kernels; not with `element`, `element_by_part` or
-    /// `max_bulk_ratio`).
+    /// K/G capped at 5000, f32 kernels, mass scaling to 1.3x the initial step; not with
+    /// `element`, `element_by_part`, `max_bulk_ratio`, `precision` or `mass_scaling`).
     pub fidelity: Option<String>,
     /// Element-kernel precision, `"f64"` or `"f32"` (default: the preset's).
     pub precision: Option<String>,
@@ -392,7 +392,10 @@ fn apply_solver(sv: &SolverSpec, base: &mut PalpationSetup) -> Result<(), String
                 || sv.precision.is_some()
                 || sv.mass_scaling.is_some())
         {
-            return Err("solver.fidelity = \"fast\" sets the element, max_bulk_ratio, precision and mass_scaling: give the preset or those keys".into());
+            return Err(scene::palpation::Fidelity::fast_conflict(
+                "solver.fidelity = \"fast\"",
+                false,
+            ));
         }
         fid.apply(base);
         base.fidelity = fid;

@@ -149,10 +149,7 @@ impl PalpateArgs {
                 || self.precision.is_some()
                 || self.mass_scaling.is_some())
         {
-            return Err(
-                "--fidelity fast sets --element, --max-bulk-ratio, --precision and --mass-scaling: give the preset or the options"
-                    .into(),
-            );
+            return Err(Fidelity::fast_conflict("--fidelity fast", true));
         }
         fidelity.apply(&mut s);
         s.fidelity = fidelity;

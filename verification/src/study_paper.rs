@@ -47,7 +47,7 @@
 use crate::study::run_one;
 use crate::study_paper_record::{RunRecord, StudySetting};
 use phantom::Phantom;
-use scene::palpation::{ElementChoice, Fidelity, PalpationSetup, Place};
+use scene::palpation::{ElementChoice, PalpationSetup, Place};
 use scene::run::RunStatus;
 use solver::element::precision::Precision;
 use solver::model::StepTarget;
@@ -71,7 +71,7 @@ pub fn base_setup(location: &str) -> PalpationSetup {
         place: Place::Named(location.into()),
         vtk: false,
         element: ElementChoice::OnePointPhysical,
-        max_bulk_ratio: Some(Fidelity::FAST_BULK_RATIO),
+        max_bulk_ratio: Some(5000.0),
         precision: Precision::F32,
         mass_scaling: Some(StepTarget::Initial(1.0)),
         title: format!("study at 3 mm, location {location}"),
@@ -83,10 +83,8 @@ pub fn base_setup(location: &str) -> PalpationSetup {
 /// change of one knob of the base per setting.
 pub fn plan(location: &str) -> Vec<StudySetting> {
     let base = base_setup(location);
-    // A changed knob is no longer the preset.
     let one = |f: &dyn Fn(&mut PalpationSetup)| {
         let mut s = base.clone();
-        s.fidelity = Fidelity::Standard;
         f(&mut s);
         s
     };
@@ -262,7 +260,6 @@ mod tests {
                 k => panic!("unknown knob {k}"),
             }
             assert_ne!(st.setup, s, "{} = {} changes nothing", st.knob, st.setting);
-            s.fidelity = base.fidelity;
             assert_eq!(
                 s, base,
                 "{} = {} changes more than its knob",
@@ -274,7 +271,6 @@ mod tests {
         r.element = base.element;
         r.max_bulk_ratio = base.max_bulk_ratio;
         r.precision = base.precision;
-        r.fidelity = base.fidelity;
         assert_eq!(r, base);
     }
 

@@ -58,15 +58,18 @@ impl SettingSummary {
     }
 }
 
+/// The `fast` preset's budget ([`scene::palpation::Fidelity::Fast`] is its answer): a force
+/// error below the spread between the 4, 3 and 2.5 mm meshes (8-11 %), and a per-sample Fit
+/// well above the agreement of the ROI field between 3 and 2.5 mm voxels (0.28-0.67). It was
+/// set with the study's records in hand.
+pub const FAST_PRESET_BUDGET: (f64, f64) = (0.10, 0.75);
+
 /// The error budgets the report checks: (|hand force error| at most, per-sample Fit at least).
-/// The fourth is the `fast` preset's ([`scene::palpation::Fidelity::Fast`] is its answer): a
-/// force error below the spread between the 4, 3 and 2.5 mm meshes (8-11 %), and a per-sample
-/// Fit well above the agreement of the ROI field between 3 and 2.5 mm voxels (0.28-0.67).
 pub const BUDGETS: [(f64, f64); 5] = [
     (0.02, 0.98),
     (0.05, 0.95),
     (0.10, 0.90),
-    (0.10, 0.75),
+    FAST_PRESET_BUDGET,
     (0.15, 0.80),
 ];
 
