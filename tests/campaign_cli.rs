@@ -387,6 +387,40 @@ fn shipped_profiles_resolve_and_bad_keys_are_named() {
     let sx = ys(&sobol, 'S');
     assert_eq!(sx.len(), 100, "{sobol}");
     assert!(sx.iter().all(|y| (165.0..=225.0).contains(y)), "{sx:?}");
+    // the 3 mm front's profile: the same sequence, 200 points, its first 100 the 5 mm front's,
+    // and the same held-out points
+    let xy = |table: &str, prefix: char| -> Vec<(String, String)> {
+        table
+            .lines()
+            .filter(|l| l.trim_start().starts_with(prefix))
+            .filter_map(|l| {
+                let w: Vec<&str> = l.split_whitespace().collect();
+                Some((w.get(3)?.to_string(), w.get(4)?.to_string()))
+            })
+            .collect()
+    };
+    let sobol3 = dry_run("campaign-sobol-3mm.toml");
+    assert!(
+        sobol3.contains("215 runs (215 locations: 200 train, 15 test)")
+            && sobol3.contains("voxel 3.0 mm"),
+        "{sobol3}"
+    );
+    let (s5, s3) = (xy(&sobol, 'S'), xy(&sobol3, 'S'));
+    assert_eq!((s5.len(), s3.len()), (100, 200), "{sobol3}");
+    assert_eq!(s3[..100], s5[..]);
+    assert_eq!(xy(&sobol3, 'T'), xy(&sobol, 'T'));
+    assert_eq!(xy(&sobol3, 'T').len(), 12);
+    // the raster and the adaptive start of the 3 mm front share those held-out points, and the
+    // adaptive start is the Sobol design's first 10
+    let grid3 = dry_run("campaign-grid-3mm-fast.toml");
+    assert!(grid3.contains("40 runs (40 locations: 25 train, 15 test)"), "{grid3}");
+    let adaptive3 = dry_run("campaign-adaptive-3mm.toml");
+    assert!(adaptive3.contains("25 runs (25 locations: 10 train, 15 test)"), "{adaptive3}");
+    for table in [&grid3, &adaptive3] {
+        assert!(table.contains("voxel 3.0 mm"), "{table}");
+        assert_eq!(xy(table, 'T'), xy(&sobol3, 'T'));
+    }
+    assert_eq!(xy(&adaptive3, 'S'), s3[..10]);
     fails_naming("[indentation]\ndepht = \"5 mm\"\n", "depht");
     fails_naming(
         "[[locations.design]]\nkind = \"halton\"\nn = 4\nseed = 1\nsplit = \"train\"\n",
