@@ -413,9 +413,15 @@ fn shipped_profiles_resolve_and_bad_keys_are_named() {
     // the raster and the adaptive start of the 3 mm front share those held-out points, and the
     // adaptive start is the Sobol design's first 10
     let grid3 = dry_run("campaign-grid-3mm-fast.toml");
-    assert!(grid3.contains("40 runs (40 locations: 25 train, 15 test)"), "{grid3}");
+    assert!(
+        grid3.contains("40 runs (40 locations: 25 train, 15 test)"),
+        "{grid3}"
+    );
     let adaptive3 = dry_run("campaign-adaptive-3mm.toml");
-    assert!(adaptive3.contains("25 runs (25 locations: 10 train, 15 test)"), "{adaptive3}");
+    assert!(
+        adaptive3.contains("25 runs (25 locations: 10 train, 15 test)"),
+        "{adaptive3}"
+    );
     for table in [&grid3, &adaptive3] {
         assert!(table.contains("voxel 3.0 mm"), "{table}");
         assert_eq!(xy(table, 'T'), xy(&sobol3, 'T'));

@@ -182,7 +182,6 @@ enum Command {
     },
 }
 
-/// Set the global thread pool.
 /// Worker stacks of the global pool: `palpate` and `run` put their whole time loop on a worker
 /// ([`scene::run::run_scene_on_pool`]), so it gets the main thread's 8 MiB and more.
 const WORKER_STACK: usize = 16 << 20;

@@ -134,9 +134,10 @@ impl PalpateArgs {
             .unwrap_or("one_point")
             .parse::<ElementChoice>()
             .map_err(|e| format!("--element: {e}"))?;
-        s.mass_scaling =
-            solver::model::StepTarget::parse_switch(self.mass_scaling.as_deref().unwrap_or("initial"))
-                .map_err(|e| format!("--mass-scaling: {e}"))?;
+        s.mass_scaling = solver::model::StepTarget::parse_switch(
+            self.mass_scaling.as_deref().unwrap_or("initial"),
+        )
+        .map_err(|e| format!("--mass-scaling: {e}"))?;
         s.dt_factor = self.dt_factor;
         s.max_bulk_ratio = self.max_bulk_ratio;
         let fidelity = self

@@ -132,7 +132,13 @@ pub fn run_loaded(scene: &mut Scene, out: &Path, quiet: bool) -> (RunSummary, Op
         println!("  note: {n}");
     }
     if !quiet && scene.sim.model.added_mass() > 0.0 {
-        for m in scene.sim.model.part_mass.iter().filter(|m| m.physical > 0.0) {
+        for m in scene
+            .sim
+            .model
+            .part_mass
+            .iter()
+            .filter(|m| m.physical > 0.0)
+        {
             println!(
                 "  mass scaling: part {} +{:.3} % ({} of {} elements scaled)",
                 m.name,

@@ -98,11 +98,7 @@ pub fn plan(location: &str) -> Vec<StudySetting> {
                 s.precision = Precision::F64;
             }),
         ),
-        StudySetting::new(
-            BASE,
-            "1pt-physical, K/G <= 5000, f32, 3 mm",
-            base.clone(),
-        ),
+        StudySetting::new(BASE, "1pt-physical, K/G <= 5000, f32, 3 mm", base.clone()),
     ];
     for (mm, h) in [("4", 0.004), ("2.5", 0.0025)] {
         v.push(StudySetting::new(
