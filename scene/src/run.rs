@@ -719,7 +719,7 @@ fn summarise(scene: &Scene, wall: f64, status: RunStatus, rec: &Recorder) -> Run
                 part: p.name.clone(),
                 physical_kg: p.physical,
                 added_kg: p.added,
-                added_percent: 100.0 * p.added / p.physical.max(1e-300),
+                added_percent: 100.0 * p.added_fraction(),
             })
             .collect(),
         bulk_modulus: scene

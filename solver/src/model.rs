@@ -501,6 +501,13 @@ pub struct PartMass {
     pub scaled_elements: usize,
 }
 
+impl PartMass {
+    /// Added mass as a fraction of the physical mass (0 for a massless part).
+    pub fn added_fraction(&self) -> f64 {
+        self.added / self.physical.max(1e-300)
+    }
+}
+
 /// The assembled model.
 #[derive(Clone, Debug)]
 pub struct Model {

@@ -546,10 +546,7 @@ impl Simulation {
                     .part_mass
                     .iter()
                     .enumerate()
-                    .max_by(|a, b| {
-                        let r = |m: &crate::model::PartMass| m.added / m.physical.max(1e-300);
-                        r(a.1).total_cmp(&r(b.1))
-                    })
+                    .max_by(|a, b| a.1.added_fraction().total_cmp(&b.1.added_fraction()))
                     .expect("a model has parts");
                 return Err(SolverError::ElementFailure {
                     element: e,
@@ -565,7 +562,7 @@ impl Simulation {
                         100.0 * added / phys,
                         100.0 * ms.max_added,
                         pm.name,
-                        100.0 * pm.added / pm.physical.max(1e-300),
+                        100.0 * pm.added_fraction(),
                         pm.scaled_elements
                     ),
                 });

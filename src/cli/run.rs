@@ -142,7 +142,7 @@ pub fn run_loaded(scene: &mut Scene, out: &Path, quiet: bool) -> (RunSummary, Op
             println!(
                 "  mass scaling: part {} +{:.3} % ({} of {} elements scaled)",
                 m.name,
-                100.0 * m.added / m.physical,
+                100.0 * m.added_fraction(),
                 m.scaled_elements,
                 m.elements
             );
