@@ -16,7 +16,10 @@
 //!   scenes/campaign-5mm.toml, scenes/campaign-fbar-8mm.toml, scenes/campaign-wide-grid.toml,
 //!   scenes/campaign-convergence-2.5mm.toml)
 //!   resolve on their phantoms (`--dry-run`), the default raster covers the ROI's plan extent,
-//!   and a bad key is an error naming it.
+//!   and a bad key is an error naming it;
+//! - a respiratory campaign (`[locations] phases`) has the phase as its sixth input column,
+//!   reads each run's ROI through the points carried with the liver, and at the reference
+//!   phase gives the plain campaign's numbers bit for bit; its model takes the phase.
 
 use std::path::Path;
 use std::process::{Command, Stdio};
@@ -480,4 +483,114 @@ fn tiny_sample_interval_refused() {
     )
     .unwrap();
     ok(&["campaign", s(&p), "--dry-run"]);
+}
+
+/// A respiratory campaign (`[locations] phases`): every location at each phase, labelled
+/// `<label>-ph<phase>`; the dataset's sixth input column is the phase; each run reads the
+/// reference ROI's points through its `roi_map.json`; a run at the reference phase is the plain
+/// run bit for bit (the same phantom, ROI and press); `palpa train` fits on (x, y, force,
+/// phase), and `palpa predict --phase` takes it (refused for a model without one).
+#[test]
+fn respiratory_campaign_adds_the_phase_as_an_input() {
+    let tmp = tempfile::tempdir().unwrap();
+    let plain_file = tmp.path().join("plain.toml");
+    let base = TINY.replace("train = [\"P07\", \"P12\"]", "train = [\"P07\"]");
+    std::fs::write(&plain_file, &base).unwrap();
+    let resp_file = tmp.path().join("resp.toml");
+    let resp = base.replace("test = [\"A\"]", "test = [\"A\"]\nphases = [0.0, 1.0]");
+    std::fs::write(&resp_file, &resp).unwrap();
+    let (plain, breath) = (tmp.path().join("plain"), tmp.path().join("breath"));
+    for (file, out) in [(&plain_file, &plain), (&resp_file, &breath)] {
+        ok(&["campaign", s(file), "--out", s(out), "--quiet"]);
+    }
+    let p = Dataset::read(plain.join("dataset.npz")).unwrap();
+    let d = Dataset::read(breath.join("dataset.npz")).unwrap();
+    assert_eq!(
+        d.manifest.x_columns,
+        ["x", "y", "force", "time", "depth", "phase"]
+    );
+    assert_eq!(
+        d.manifest.location_labels,
+        ["P07-ph0", "P07-ph1", "A-ph0", "A-ph1"]
+    );
+    assert_eq!(d.n_roi(), p.n_roi());
+    assert_eq!(d.roi_ids, p.roi_ids);
+    for i in 0..d.n_samples() {
+        let want = [0.0, 1.0][d.location[i] as usize % 2];
+        assert_eq!(d.x[(i, 5)], want, "row {i}");
+    }
+    // the reference phase: the plain campaign's rows, bit for bit (P07 and A)
+    for (pl, dl) in [(0i64, 0i64), (1, 2)] {
+        let rows = |ds: &Dataset, l: i64| -> Vec<usize> {
+            (0..ds.n_samples())
+                .filter(|&i| ds.location[i] == l)
+                .collect()
+        };
+        let (a, b) = (rows(&p, pl), rows(&d, dl));
+        assert_eq!(a.len(), b.len());
+        for (&i, &j) in a.iter().zip(&b) {
+            assert_eq!(p.y.row(i), d.y.row(j), "location {dl}, row {j}");
+            for c in 0..5 {
+                assert_eq!(
+                    p.x[(i, c)],
+                    d.x[(j, c)],
+                    "location {dl}, row {j}, column {c}"
+                );
+            }
+        }
+    }
+    // each run's ROI map: the plan's ROI at phase 0, the liver's points carried at phase 1
+    let map = |label: &str| -> Vec<i64> {
+        let t =
+            std::fs::read_to_string(breath.join("runs").join(label).join("roi_map.json")).unwrap();
+        let v: serde_json::Value = serde_json::from_str(&t).unwrap();
+        v["roi_elements"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|e| e.as_i64().unwrap())
+            .collect()
+    };
+    assert_eq!(map("A-ph0"), p.roi_ids.to_vec());
+    assert_eq!(map("A-ph1").len(), p.n_roi());
+    assert_ne!(map("A-ph1"), p.roi_ids.to_vec());
+    // the model takes the phase; the plain one refuses it
+    let model = tmp.path().join("gp");
+    ok(&["train", s(&breath), "--model", "gp", "--out", s(&model)]);
+    let meta = std::fs::read_to_string(model.join("model.json")).unwrap();
+    assert!(
+        meta.contains(
+            "\"input_columns\": [\n    \"x\",\n    \"y\",\n    \"force\",\n    \"phase\"\n  ]"
+        ),
+        "{meta}"
+    );
+    let xy = [format!("{}", d.x[(0, 0)]), format!("{}", d.x[(0, 1)])];
+    let at = |m: &Path, phase: &str| {
+        palpa(&[
+            "predict",
+            s(m),
+            "--x",
+            &xy[0],
+            "--y",
+            &xy[1],
+            "--force",
+            "1",
+            "--phase",
+            phase,
+        ])
+    };
+    let o = at(&model, "0.5");
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert!(String::from_utf8_lossy(&o.stdout).contains("respiratory phase 0.5"));
+    let o = at(&model, "1.5");
+    assert!(!o.status.success());
+    assert!(String::from_utf8_lossy(&o.stderr).contains("phase = 1.5 is outside 0"));
+    let flat = tmp.path().join("flat");
+    ok(&["train", s(&plain), "--model", "gp", "--out", s(&flat)]);
+    let o = at(&flat, "0.5");
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        !o.status.success() && err.contains("takes x, y and force only"),
+        "{err}"
+    );
 }

@@ -116,6 +116,12 @@ pub fn check_adaptive(c: &Campaign, n: usize) -> Result<(), String> {
     if !c.locations.iter().any(|l| l.split == Split::Train) {
         return Err("--adaptive needs training locations to start from".into());
     }
+    if c.is_respiratory() {
+        return Err(
+            "--adaptive chooses (x, y) locations at one phase; this campaign presses at several respiratory phases (locations.phases or a design's phase range)"
+                .into(),
+        );
+    }
     Ok(())
 }
 
@@ -138,6 +144,7 @@ pub fn extend(c: &mut Campaign, batches: &[AdaptiveBatch]) -> Result<(), String>
             label: p.label.clone(),
             split: Split::Train,
             place: Place::At(p.at[0], p.at[1]),
+            phase: None,
         });
         c.runs.push(PlannedRun {
             index: c.runs.len(),

@@ -1,12 +1,16 @@
 //! The training dataset of a campaign ([`surrogate::Dataset`]): every sample of every run, in
 //! plan order. X holds x, y [m], force [N], time [s] and depth [m] (indentation since first
-//! contact) per sample; the force is the hand reaction after the 1 ms centred moving average of
+//! contact) per sample, and for a respiratory campaign the phase (0 exhalation .. 1
+//! inspiration) as a sixth column; the force is the hand reaction after the 1 ms centred moving average of
 //! [`solver::output::filter`] (the raw probed value chatters with the penalty contact and stays
-//! in `probe.csv`), Y the ROI maximum principal stress [Pa], S the full Cauchy tensors. Both
+//! in `probe.csv`), Y the ROI maximum principal stress [Pa], S the full Cauchy tensors. A run at
+//! a phase of its own reads its ROI columns through its `roi_map.json` (the reference ROI's
+//! points carried with the liver, [`crate::plan::ROI_MAP_FILE`]), so column i is one point of the
+//! liver at every phase. Both
 //! `palpa campaign` and `palpa campaign merge` assemble through here, so the two write the same
 //! bytes.
 
-use crate::plan::{CampaignPlan, Split};
+use crate::plan::{CampaignPlan, PlanLocation};
 use crate::run_files::read_run;
 use ndarray::{Array1, Array2, Array3};
 use serde_json::json;
@@ -16,7 +20,7 @@ use surrogate::{Dataset, Manifest};
 
 /// The rows of one run's samples.
 struct Rows {
-    xs: Vec<[f64; 5]>,
+    xs: Vec<f64>,
     ys: Vec<f64>,
     ss: Vec<f64>,
     location: Vec<i64>,
@@ -45,6 +49,8 @@ pub fn assemble(
         location: Vec::new(),
         split: Vec::new(),
     };
+    let respiratory = plan.locations.iter().any(|l| l.phase.is_some());
+    let cols = if respiratory { 6 } else { 5 };
     let mut run_rows = Vec::new();
     for label in labels {
         let run = plan.run(label)?;
@@ -59,78 +65,102 @@ pub fn assemble(
                 )
             })?;
         let loc = &plan.locations[li];
-        let start = rows.xs.len();
-        append_run(
-            &mut rows,
-            &dir_of(label),
-            &roi_ids,
-            li,
-            loc.split,
-            loc.surface_m,
-        )?;
+        let start = rows.location.len();
+        let dir = dir_of(label);
+        let ids = match loc.phase {
+            Some(_) => carried_roi(&dir)?,
+            None => roi_ids.clone(),
+        };
+        let phase = respiratory.then(|| loc.phase.unwrap_or(plan.phantom.respiratory_phase));
+        append_run(&mut rows, &dir, &ids, li, loc, phase)?;
         run_rows.push(json!({
             "label": label,
             "location": run.location,
             "split": loc.split.name(),
             "depth_m": run.depth_m,
             "duration_s": run.duration_s,
-            "rows": [start, rows.xs.len()],
+            "rows": [start, rows.location.len()],
         }));
     }
-    let n = rows.xs.len();
+    let n = rows.location.len();
     Ok(Dataset {
-        x: Array2::from_shape_vec((n, 5), rows.xs.concat()).map_err(|e| e.to_string())?,
+        x: Array2::from_shape_vec((n, cols), rows.xs).map_err(|e| e.to_string())?,
         y: Array2::from_shape_vec((n, r), rows.ys).map_err(|e| e.to_string())?,
         stress: Some(Array3::from_shape_vec((n, r, 6), rows.ss).map_err(|e| e.to_string())?),
         roi_ids: Array1::from(roi_ids),
         roi_centroids,
         location: Array1::from(rows.location),
         split: Array1::from(rows.split),
-        manifest: manifest(plan, run_rows),
+        manifest: manifest(plan, run_rows, respiratory),
     })
 }
 
-/// Append the samples of the run in `dir` (location `li` at skin point `at`).
+/// The element ids of a respiratory run's carried ROI, in the ROI's order.
+fn carried_roi(dir: &Path) -> Result<Vec<i64>, String> {
+    let path = dir.join(crate::plan::ROI_MAP_FILE);
+    let text = std::fs::read_to_string(&path)
+        .map_err(|e| format!("{}: cannot read the run's ROI map: {e}", path.display()))?;
+    #[derive(serde::Deserialize)]
+    #[serde(deny_unknown_fields)]
+    struct RoiMap {
+        roi_elements: Vec<i64>,
+    }
+    let m: RoiMap = serde_json::from_str(&text).map_err(|e| format!("{}: {e}", path.display()))?;
+    Ok(m.roi_elements)
+}
+
+/// Append the samples of the run in `dir` (location `li`, whose ROI columns are the probe's
+/// elements `roi_ids`, in order), with `phase` as a sixth input column when given.
 fn append_run(
     rows: &mut Rows,
     dir: &Path,
     roi_ids: &[i64],
     li: usize,
-    split: Split,
-    at: [f64; 3],
+    loc: &PlanLocation,
+    phase: Option<f64>,
 ) -> Result<(), String> {
     let d = read_run(dir)?;
-    // the probe's columns in the ROI's order (nearest to the ROI centre first)
+    // the probe's columns in the ROI's order (nearest to the ROI centre first); a carried ROI
+    // may read one element twice, and its probe lists each element once
+    let mut distinct = roi_ids.to_vec();
+    distinct.sort_unstable();
+    distinct.dedup();
     let cols: Vec<usize> = roi_ids
         .iter()
         .map(|&id| d.elements.iter().position(|&e| e as i64 == id))
         .collect::<Option<_>>()
-        .filter(|_| d.elements.len() == roi_ids.len())
+        .filter(|_| d.elements.len() == distinct.len())
         .ok_or_else(|| {
             format!(
                 "{}: the probe's elements are not the campaign's ROI",
                 dir.display()
             )
         })?;
+    let at = loc.surface_m;
     for k in 0..d.time.len() {
         rows.xs
-            .push([at[0], at[1], d.force_filtered[k], d.time[k], d.depth[k]]);
+            .extend([at[0], at[1], d.force_filtered[k], d.time[k], d.depth[k]]);
+        rows.xs.extend(phase);
         rows.ys.extend(cols.iter().map(|&c| d.max_principal[k][c]));
         for &c in &cols {
             rows.ss.extend(&d.tensors[k][c]);
         }
         rows.location.push(li as i64);
-        rows.split.push(split.code());
+        rows.split.push(loc.split.code());
     }
     Ok(())
 }
 
 /// The dataset's manifest: columns, locations, the solver's settings and runs, the phantom.
-fn manifest(plan: &CampaignPlan, run_rows: Vec<serde_json::Value>) -> Manifest {
+fn manifest(plan: &CampaignPlan, run_rows: Vec<serde_json::Value>, respiratory: bool) -> Manifest {
+    let mut x_columns: Vec<String> = ["x", "y", "force", "time", "depth"]
+        .map(String::from)
+        .to_vec();
+    if respiratory {
+        x_columns.push("phase".into());
+    }
     let mut manifest = Manifest {
-        x_columns: ["x", "y", "force", "time", "depth"]
-            .map(String::from)
-            .to_vec(),
+        x_columns,
         location_labels: plan.locations.iter().map(|l| l.label.clone()).collect(),
         solver: json!({
             "name": "palpa",
@@ -155,6 +185,12 @@ fn manifest(plan: &CampaignPlan, run_rows: Vec<serde_json::Value>) -> Manifest {
     manifest
         .units
         .insert("split".into(), "0 train, 1 test".into());
+    if respiratory {
+        manifest.units.insert(
+            "phase".into(),
+            "respiratory phase, 0 exhalation .. 1 inspiration (the liver moves caudally by phase x max_liver_shift)".into(),
+        );
+    }
     manifest
 }
 

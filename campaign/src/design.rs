@@ -16,11 +16,17 @@
 //!   trainers), for held-out sets that no design rule chose; a polygon keeps the draws inside
 //!   it.
 //!
+//! A design with a `phase = [lo, hi]` range is a design over (x, y, phase) for a respiratory
+//! campaign: its third coordinate, mapped onto the range, is each point's respiratory phase.
+//! For Sobol it is the sequence's third dimension (the (x, y) points are those of the
+//! two-dimensional design with the same seed); for LHS a third stratified axis; for random a
+//! uniform draw of its own stream. Either way the (x, y) points do not change.
+//!
 //! The same file and seed give the same points, bit for bit, on every machine (both are pure
 //! integer arithmetic and one multiply-add per coordinate).
 
 use crate::plan::{CampaignLocation, Split};
-use material::quantity::Length;
+use material::quantity::{Length, Number};
 use scene::palpation::Place;
 use serde::Deserialize;
 
@@ -71,6 +77,9 @@ pub struct DesignSpec {
     /// A polygon `[[x, y], ...]` (at least 3 corners, in either order) instead of a rectangle;
     /// Sobol and random only.
     pub polygon: Option<Vec<[Length; 2]>>,
+    /// `[lo, hi]`: the respiratory phases the design spans (module doc); absent: the points
+    /// have no phase of their own.
+    pub phase: Option<[Number; 2]>,
 }
 
 impl DesignSpec {
@@ -84,14 +93,45 @@ impl DesignSpec {
         crate::label::check_label(&prefix)?;
         let width = self.n.to_string().len().max(2);
         Ok(self
-            .points()?
+            .points_with_phase()?
             .into_iter()
             .enumerate()
-            .map(|(k, [x, y])| CampaignLocation {
+            .map(|(k, ([x, y], phase))| CampaignLocation {
                 label: format!("{prefix}{:0width$}", k + 1),
                 split: self.split,
                 place: Place::At(x, y),
+                phase,
             })
+            .collect())
+    }
+
+    /// The design's points (x, y) in m, each with its respiratory phase when the design has a
+    /// `phase` range (module doc).
+    pub fn points_with_phase(&self) -> Result<Vec<([f64; 2], Option<f64>)>, String> {
+        let n = self.n;
+        if n == 0 || n > MAX_DESIGN_POINTS {
+            return Err(format!(
+                "locations.design: n = {n}; a design has 1 to {MAX_DESIGN_POINTS} points"
+            ));
+        }
+        let drawn = self.region()?.draw_indexed(self.kind, n, self.seed)?;
+        let Some([lo, hi]) = self.phase.map(|p| [p[0].0, p[1].0]) else {
+            return Ok(drawn.into_iter().map(|(_, p)| (p, None)).collect());
+        };
+        for p in [lo, hi] {
+            crate::spec::check_phase(p, "locations.design.phase")?;
+        }
+        if lo > hi {
+            return Err(format!(
+                "locations.design.phase: [{lo}, {hi}] is not a range (low first)"
+            ));
+        }
+        let idx: Vec<usize> = drawn.iter().map(|d| d.0).collect();
+        let u = third_axis(self.kind, &idx, self.seed);
+        Ok(drawn
+            .into_iter()
+            .zip(u)
+            .map(|((_, p), u)| (p, Some(lo + (hi - lo) * u)))
             .collect())
     }
 
@@ -114,13 +154,7 @@ impl DesignSpec {
 
     /// The design's points (x, y) in m.
     pub fn points(&self) -> Result<Vec<[f64; 2]>, String> {
-        let n = self.n;
-        if n == 0 || n > MAX_DESIGN_POINTS {
-            return Err(format!(
-                "locations.design: n = {n}; a design has 1 to {MAX_DESIGN_POINTS} points"
-            ));
-        }
-        self.region()?.draw(self.kind, n, self.seed)
+        Ok(self.points_with_phase()?.into_iter().map(|p| p.0).collect())
     }
 }
 
@@ -142,6 +176,20 @@ impl Region {
     /// `n` points of `kind` and `seed` in the region (module doc): a Latin hypercube of the
     /// rectangle, or the first `n` Sobol or random points of the bounding box that lie inside.
     pub fn draw(&self, kind: DesignKind, n: usize, seed: u32) -> Result<Vec<[f64; 2]>, String> {
+        Ok(self
+            .draw_indexed(kind, n, seed)?
+            .into_iter()
+            .map(|d| d.1)
+            .collect())
+    }
+
+    /// [`Region::draw`] with each point's index in its sequence (for a third coordinate).
+    fn draw_indexed(
+        &self,
+        kind: DesignKind,
+        n: usize,
+        seed: u32,
+    ) -> Result<Vec<(usize, [f64; 2])>, String> {
         let (bbox, poly) = match self {
             Region::Rect(r) => (*r, None),
             Region::Polygon(p) => (polygon_bbox(p)?, Some(p)),
@@ -152,7 +200,8 @@ impl Region {
             }
             return Ok(latin_hypercube(n, seed)
                 .into_iter()
-                .map(|u| map_to(&bbox, u))
+                .enumerate()
+                .map(|(k, u)| (k, map_to(&bbox, u)))
                 .collect());
         }
         let mut out = Vec::with_capacity(n.min(MAX_DESIGN_POINTS));
@@ -167,7 +216,7 @@ impl Region {
             };
             let p = map_to(&bbox, u);
             if poly.is_none_or(|q| inside(q, p)) {
-                out.push(p);
+                out.push((i, p));
             }
         }
         if out.len() == n {
@@ -177,6 +226,35 @@ impl Region {
             "locations.design.polygon: only {} of {MAX_DESIGN_POINTS} points drawn lie inside the polygon, fewer than n = {n}",
             out.len()
         ))
+    }
+}
+
+/// The seed of a design's third (phase) axis for random and LHS designs: a stream of its own,
+/// so that the (x, y) points do not change.
+const PHASE_STREAM: u64 = 0x5048_4153_4500_0000;
+
+/// The third coordinate in [0, 1) of the design points with sequence indices `idx` (module
+/// doc).
+fn third_axis(kind: DesignKind, idx: &[usize], seed: u32) -> Vec<f64> {
+    let mut rng = surrogate::rng::Rng::new(u64::from(seed) ^ PHASE_STREAM);
+    match kind {
+        DesignKind::Sobol => idx
+            .iter()
+            .map(|&i| f64::from(sobol_burley::sample(i as u32, 2, seed)))
+            .collect(),
+        DesignKind::Random => {
+            let last = idx.iter().copied().max().unwrap_or(0);
+            let u: Vec<f64> = (0..=last).map(|_| rng.uniform()).collect();
+            idx.iter().map(|&i| u[i]).collect()
+        }
+        DesignKind::Lhs => {
+            let n = idx.len();
+            let mut perm: Vec<usize> = (0..n).collect();
+            rng.shuffle(&mut perm);
+            perm.iter()
+                .map(|&p| (p as f64 + rng.uniform()) / n as f64)
+                .collect()
+        }
     }
 }
 
@@ -279,6 +357,7 @@ mod tests {
             prefix: None,
             extent: None,
             polygon: None,
+            phase: None,
         }
     }
 
@@ -367,5 +446,43 @@ mod tests {
         s.polygon = None;
         s.prefix = Some("../x".into());
         assert!(s.locations().unwrap_err().contains("directory"));
+    }
+
+    /// A phase range makes a design over (x, y, phase): the (x, y) points stay those of the
+    /// plain design; every phase lies in the range; LHS stratifies the phase axis too; Sobol's
+    /// third dimension fills it (every eighth of it holds points among the first 64); a bad
+    /// range is refused.
+    #[test]
+    fn phase_range_adds_a_third_coordinate() {
+        for kind in [DesignKind::Sobol, DesignKind::Lhs, DesignKind::Random] {
+            let plain = spec(kind, 64).points().unwrap();
+            let mut s = spec(kind, 64);
+            s.phase = Some([Number(0.2), Number(0.6)]);
+            let pts = s.points_with_phase().unwrap();
+            let xy: Vec<[f64; 2]> = pts.iter().map(|p| p.0).collect();
+            assert_eq!(xy, plain, "{kind:?}");
+            let ph: Vec<f64> = pts.iter().map(|p| p.1.unwrap()).collect();
+            assert!(ph.iter().all(|&p| (0.2..=0.6).contains(&p)), "{kind:?}");
+            let mut count = [0usize; 64];
+            for &p in &ph {
+                count[(((p - 0.2) / 0.4 * 64.0) as usize).min(63)] += 1;
+            }
+            match kind {
+                DesignKind::Lhs => assert!(count.iter().all(|&c| c == 1), "{count:?}"),
+                DesignKind::Sobol => {
+                    assert!(
+                        count.chunks(8).all(|c| c.iter().sum::<usize>() == 8),
+                        "{count:?}"
+                    )
+                }
+                DesignKind::Random => {}
+            }
+            assert!(s.locations().unwrap().iter().all(|l| l.phase.is_some()));
+        }
+        let mut s = spec(DesignKind::Sobol, 4);
+        s.phase = Some([Number(0.5), Number(1.5)]);
+        assert!(s.points().unwrap_err().contains("outside 0"));
+        s.phase = Some([Number(0.8), Number(0.2)]);
+        assert!(s.points().unwrap_err().contains("not a range"));
     }
 }

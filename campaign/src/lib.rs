@@ -182,6 +182,44 @@ mod tests {
         }
     }
 
+    /// `[locations] phases` presses every location without a phase of its own at each phase,
+    /// labelled by it; a design's phase range gives its points their own; bad phases are named.
+    #[test]
+    fn phases_cross_the_locations() {
+        let spec: CampaignSpec = toml::from_str(
+            "[locations]\ntrain = [\"P07\"]\ntest = [\"A\"]\nphases = [0.0, 0.25]\n\
+             [[locations.design]]\nkind = \"sobol\"\nn = 3\nseed = 1\nsplit = \"train\"\nphase = [0.0, 1.0]\n",
+        )
+        .unwrap();
+        let c = spec.resolve().unwrap();
+        let labels: Vec<(&str, Option<f64>)> = c
+            .locations
+            .iter()
+            .map(|l| (l.label.as_str(), l.phase))
+            .collect();
+        assert_eq!(labels.len(), 7);
+        assert_eq!(
+            &labels[..2],
+            [("P07-ph0", Some(0.0)), ("P07-ph0.25", Some(0.25))]
+        );
+        assert!(labels[2..5]
+            .iter()
+            .all(|(l, p)| l.starts_with('S') && p.is_some()));
+        assert_eq!(
+            &labels[5..],
+            [("A-ph0", Some(0.0)), ("A-ph0.25", Some(0.25))]
+        );
+        assert!(c.is_respiratory());
+        assert_eq!(c.setup(&c.runs[1]).respiratory_phase, 0.25);
+        assert!(!Campaign::paper().is_respiratory());
+        for (bad, key) in [("[]", "empty"), ("[0.5, 1.2]", "outside 0")] {
+            let spec: CampaignSpec =
+                toml::from_str(&format!("[locations]\nphases = {bad}\n")).unwrap();
+            let e = spec.resolve().unwrap_err();
+            assert!(e.contains("locations.phases") && e.contains(key), "{e}");
+        }
+    }
+
     #[test]
     fn default_is_the_paper_protocol() {
         let c = Campaign::paper();

@@ -14,6 +14,10 @@ use std::collections::BTreeMap;
 use std::path::Path;
 pub use surrogate::Split;
 
+/// A respiratory run's file of its ROI: the element ids of its own mesh that carry the
+/// reference ROI's points, in the ROI's order (`{"roi_elements": [...]}`).
+pub const ROI_MAP_FILE: &str = "roi_map.json";
+
 /// One location of a campaign.
 #[derive(Clone, Debug, PartialEq)]
 pub struct CampaignLocation {
@@ -23,6 +27,9 @@ pub struct CampaignLocation {
     pub split: Split,
     /// Where the fingers press.
     pub place: Place,
+    /// The respiratory phase it is pressed at (0 exhalation .. 1 inspiration); `None`: the
+    /// phantom's own (`[phantom] respiratory_phase`, the ROI's reference frame).
+    pub phase: Option<f64>,
 }
 
 /// One run of a campaign.
@@ -64,13 +71,21 @@ impl Campaign {
 
     /// The palpation of run `r`.
     pub fn setup(&self, r: &PlannedRun) -> PalpationSetup {
+        let loc = &self.locations[r.location];
         PalpationSetup {
             title: format!("{}: {}", self.title, r.label),
-            place: self.locations[r.location].place.clone(),
+            place: loc.place.clone(),
             depth: r.depth,
             duration: r.duration,
+            respiratory_phase: loc.phase.unwrap_or(self.base.respiratory_phase),
             ..self.base.clone()
         }
+    }
+
+    /// Whether some location is pressed at a phase of its own (a respiratory campaign: its
+    /// dataset has a `phase` input column).
+    pub fn is_respiratory(&self) -> bool {
+        self.locations.iter().any(|l| l.phase.is_some())
     }
 
     /// Samples each run records: at 0, sample_interval, ... up to the duration.
@@ -103,7 +118,14 @@ impl Campaign {
             .collect()
     }
 
-    /// Write run `r`'s `scene.toml` into `dir` and build it, reusing `phantom`.
+    /// Write run `r`'s `scene.toml` into `dir` and build it, reusing `phantom` (the campaign's
+    /// phantom, at its reference phase).
+    ///
+    /// A run at a phase of its own builds that phase's phantom, carries the reference ROI onto
+    /// it with the liver ([`Phantom::carry_roi_from`]) and writes the carried element ids, in
+    /// the ROI's order, to [`ROI_MAP_FILE`]; a named location (A, B, ...) is pressed at the
+    /// reference phantom's skin point, so that it stays one place of the body while the liver
+    /// moves under it.
     pub fn build_run_scene(
         &self,
         r: &PlannedRun,
@@ -112,7 +134,37 @@ impl Campaign {
     ) -> Result<Scene, String> {
         std::fs::create_dir_all(dir)
             .map_err(|e| format!("{}: cannot create the run directory: {e}", dir.display()))?;
-        self.setup(r).build_scene(dir, Some(phantom.clone()))
+        let mut setup = self.setup(r);
+        if self.locations[r.location].phase.is_none() {
+            return setup.build_scene(dir, Some(phantom.clone()));
+        }
+        let mut ph = if setup.respiratory_phase == phantom.params.respiratory_phase {
+            phantom.clone()
+        } else {
+            phantom::build(&PhantomParams {
+                respiratory_phase: setup.respiratory_phase,
+                ..phantom.params.clone()
+            })
+            .map_err(|e| {
+                format!(
+                    "run {}: the phantom at phase {}: {e}",
+                    r.label, setup.respiratory_phase
+                )
+            })?
+        };
+        ph.carry_roi_from(&phantom.roi, phantom.params.liver_shift())
+            .map_err(|e| format!("run {}: {e}", r.label))?;
+        if let Place::Named(n) = &setup.place {
+            let at = phantom
+                .locations
+                .get(n)
+                .ok_or_else(|| format!("location {n}: the phantom has no such location"))?
+                .surface;
+            setup.place = Place::At(at[0], at[1]);
+        }
+        let map = serde_json::json!({ "roi_elements": ph.roi.elements });
+        solver::output::atomic::write_atomic(&dir.join(ROI_MAP_FILE), map.to_string().as_bytes())?;
+        setup.build_scene(dir, Some(ph))
     }
 
     /// The plan of this campaign on the built phantom `ph` with its resolved locations `locs`:
@@ -161,6 +213,7 @@ impl Campaign {
                     surface_m: s.surface,
                     liver_depth_m: s.liver_depth,
                     under_ribs: s.under_ribs,
+                    phase: l.phase,
                 })
                 .collect(),
             runs: self
@@ -264,8 +317,11 @@ pub struct PlanLocation {
     pub surface_m: [f64; 3],
     /// Depth of the liver below it (m), `None` where no liver is below.
     pub liver_depth_m: Option<f64>,
-    /// Whether ribs lie between skin and liver.
+    /// Whether ribs lie between skin and liver (at the reference phase).
     pub under_ribs: bool,
+    /// The respiratory phase it is pressed at; absent when the phantom's own.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub phase: Option<f64>,
 }
 
 /// One run of a plan.

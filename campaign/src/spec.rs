@@ -104,6 +104,10 @@ pub struct LocationsSpec {
     /// Space-filling designs (Sobol, Latin hypercube or seeded uniform random).
     #[serde(default)]
     pub design: Vec<DesignSpec>,
+    /// Respiratory phases (0 exhalation .. 1 inspiration): every location without a phase of
+    /// its own (a design's `phase` range gives one) is pressed at each, labelled
+    /// `<label>-ph<phase>` (a respiratory campaign).
+    pub phases: Option<Vec<Number>>,
 }
 
 /// `[indentation]`.
@@ -185,6 +189,7 @@ fn entry_locations(e: &LocationEntry, split: Split) -> Result<Vec<CampaignLocati
         label: n.to_string(),
         split,
         place: Place::Named(n.to_string()),
+        phase: None,
     };
     Ok(match e {
         LocationEntry::Name(n) if n.eq_ignore_ascii_case("grid") => {
@@ -212,6 +217,7 @@ fn entry_locations(e: &LocationEntry, split: Split) -> Result<Vec<CampaignLocati
                 label: format!("at_{}_{}", short(x * 1e3, 1), short(y * 1e3, 1)),
                 split,
                 place: Place::At(x, y),
+                phase: None,
             }]
         }
         LocationEntry::Named(p) => {
@@ -220,6 +226,7 @@ fn entry_locations(e: &LocationEntry, split: Split) -> Result<Vec<CampaignLocati
                 label: p.name.clone(),
                 split,
                 place: Place::At(p.at[0].0, p.at[1].0),
+                phase: None,
             }]
         }
     })
@@ -252,6 +259,7 @@ fn raster_locations(r: &RasterSpec) -> Result<(Split, Vec<CampaignLocation>), St
             label: format!("{prefix}{:02}", k + 1),
             split,
             place: Place::At(x, y),
+            phase: None,
         })
         .collect();
     Ok((split, out))
@@ -525,6 +533,9 @@ fn resolve_locations(l: &LocationsSpec) -> Result<Vec<CampaignLocation>, String>
     if locations.is_empty() {
         return Err("locations: the campaign has no locations".into());
     }
+    if let Some(phases) = &l.phases {
+        locations = cross_phases(locations, phases)?;
+    }
     let mut seen = std::collections::HashSet::new();
     for a in &locations {
         if !seen.insert(a.label.as_str()) {
@@ -535,6 +546,46 @@ fn resolve_locations(l: &LocationsSpec) -> Result<Vec<CampaignLocation>, String>
         }
     }
     Ok(locations)
+}
+
+/// Every location without a phase of its own at each of `phases` (in that order, labelled
+/// `<label>-ph<phase>`), the others as they are.
+fn cross_phases(
+    locations: Vec<CampaignLocation>,
+    phases: &[Number],
+) -> Result<Vec<CampaignLocation>, String> {
+    if phases.is_empty() {
+        return Err("locations.phases: the list is empty".into());
+    }
+    for p in phases {
+        check_phase(p.0, "locations.phases")?;
+    }
+    let mut out = Vec::new();
+    for l in locations {
+        if l.phase.is_some() {
+            out.push(l);
+            continue;
+        }
+        for p in phases {
+            out.push(CampaignLocation {
+                label: format!("{}-ph{}", l.label, short(p.0, 3)),
+                phase: Some(p.0),
+                ..l.clone()
+            });
+        }
+    }
+    Ok(out)
+}
+
+/// A respiratory phase: finite, 0 (exhalation) .. 1 (inspiration).
+pub fn check_phase(p: f64, key: &str) -> Result<(), String> {
+    if (0.0..=1.0).contains(&p) {
+        Ok(())
+    } else {
+        Err(format!(
+            "{key}: phase {p} is outside 0 (exhalation) .. 1 (inspiration)"
+        ))
+    }
 }
 
 /// The runs: locations x depths x timings, in that order, within [`MAX_RUNS`] and the sample

@@ -62,7 +62,7 @@ pub use params::{
     GridParams, PhantomParams, RoiParams, Tumour, Variant, DEFAULT_VOXEL, PAPER_VOXEL,
 };
 pub use plan::{plan_view, PlanView, PLAN_STEP};
-pub use roi::{select_roi, surface_elements, Roi};
+pub use roi::{carry_roi, organ_parts, select_roi, surface_elements, Roi};
 
 use rayon::prelude::*;
 
@@ -257,10 +257,7 @@ pub fn build(p: &PhantomParams) -> Result<Phantom, String> {
     mesh.node_sets.insert("skin".into(), skin);
 
     // ROI
-    let mut organ = vec![false; part_names.len()];
-    for (q, n) in part_names.iter().enumerate() {
-        organ[q] = n == "liver" || n.starts_with("tumour");
-    }
+    let organ = organ_parts(&part_names);
     let gx = p.grid.center[0];
     let center = p.roi.center.unwrap_or_else(|| an.liver_edge_point(gx));
     let roi = select_roi(&mesh, &organ, center, &p.roi);
@@ -311,6 +308,23 @@ pub fn build(p: &PhantomParams) -> Result<Phantom, String> {
 }
 
 impl Phantom {
+    /// Replace the ROI by `reference` (the ROI of a phantom of the same body whose liver was
+    /// shifted caudally by `reference_shift`, m) carried with the liver onto this phantom
+    /// ([`carry_roi`]): column i of both ROIs is the same point of the liver. The element set
+    /// `roi` follows.
+    pub fn carry_roi_from(&mut self, reference: &Roi, reference_shift: f64) -> Result<(), String> {
+        let d = [0.0, -(self.params.liver_shift() - reference_shift), 0.0];
+        let organ = organ_parts(&self.mesh.part_names);
+        let roi = carry_roi(&self.mesh, &organ, reference, d)
+            .ok_or("the phantom has no liver surface to carry the ROI onto")?;
+        let mut rs = roi.elements.clone();
+        rs.sort_unstable();
+        rs.dedup();
+        self.mesh.element_sets.insert("roi".into(), rs);
+        self.roi = roi;
+        Ok(())
+    }
+
     /// PNG slices (axial, sagittal, coronal) through the liver's centre into `dir`.
     pub fn write_preview(&self, dir: &std::path::Path) -> Result<Vec<std::path::PathBuf>, String> {
         let v = &self.volume;

@@ -4,6 +4,12 @@
 //! element or with nothing (tumours count as liver). The ROI keeps the surface elements whose
 //! centroid lies within `radius` of the ROI centre, nearest first, at most `max_count`
 //! (the paper's ROI had 377 elements on the liver's edge).
+//!
+//! Across respiratory phases the liver moves rigidly (caudally by `phase * max_liver_shift`),
+//! and the voxel mesh of another phase has other elements. [`carry_roi`] keeps one ROI's
+//! material points: each reference centroid `c_i`, moved with the liver to `c_i + d`, is read
+//! from the organ-surface element of the new mesh whose centroid is nearest, so that column
+//! `i` of every phase's ROI is the same point of the liver (to half a voxel).
 
 use std::collections::HashMap;
 
@@ -67,6 +73,49 @@ pub fn surface_elements(mesh: &Mesh, organ: &[bool]) -> Vec<bool> {
         }
     }
     out
+}
+
+/// Flags for the parts of `part_names` that make up the organ of the ROI: the liver and its
+/// tumours.
+pub fn organ_parts(part_names: &[String]) -> Vec<bool> {
+    part_names
+        .iter()
+        .map(|n| n == "liver" || n.starts_with("tumour"))
+        .collect()
+}
+
+/// The ROI `reference` carried by the rigid displacement `d` (m) onto `mesh` (module doc): in
+/// the reference's order, the organ-surface element nearest each moved centroid (two points
+/// may share one element). `None` when the mesh has no organ-surface element.
+pub fn carry_roi(mesh: &Mesh, organ: &[bool], reference: &Roi, d: [f64; 3]) -> Option<Roi> {
+    let surf = surface_elements(mesh, organ);
+    let cents = mesh.centroids();
+    let cand: Vec<usize> = (0..mesh.elements.len()).filter(|&e| surf[e]).collect();
+    if cand.is_empty() {
+        return None;
+    }
+    let moved = |c: [f64; 3]| [c[0] + d[0], c[1] + d[1], c[2] + d[2]];
+    let elements: Vec<u32> = reference
+        .centroids
+        .iter()
+        .map(|&c| {
+            let p = moved(c);
+            let dist = |e: usize| {
+                let q = cents[e];
+                (q[0] - p[0]).powi(2) + (q[1] - p[1]).powi(2) + (q[2] - p[2]).powi(2)
+            };
+            // nearest, ties to the lower id (a deterministic choice)
+            cand.iter()
+                .copied()
+                .min_by(|&a, &b| dist(a).total_cmp(&dist(b)).then(a.cmp(&b)))
+                .expect("candidates are not empty") as u32
+        })
+        .collect();
+    Some(Roi {
+        center: moved(reference.center),
+        centroids: elements.iter().map(|&e| cents[e as usize]).collect(),
+        elements,
+    })
 }
 
 /// Select the ROI around `center`.

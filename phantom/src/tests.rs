@@ -424,3 +424,40 @@ fn test_locations_do_not_depend_on_the_voxel_size() {
         }
     }
 }
+
+/// The ROI carried onto its own phantom is itself; carried onto the phantom of another phase
+/// (a shift of 5 mm, not a whole number of 8 mm voxels) every column lands on a liver-surface
+/// element whose centroid is within a voxel of the moved material point, and most within half
+/// a voxel (the voxel surface steps by whole voxels).
+#[test]
+fn roi_carried_across_phases_keeps_its_material_points() {
+    let p0 = coarse(Variant::Reduced);
+    let ph0 = build(&p0).unwrap();
+    let mut same = ph0.clone();
+    same.carry_roi_from(&ph0.roi, 0.0).unwrap();
+    assert_eq!(same.roi.elements, ph0.roi.elements);
+    let mut ph = build(&PhantomParams {
+        respiratory_phase: 0.25,
+        ..p0.clone()
+    })
+    .unwrap();
+    ph.carry_roi_from(&ph0.roi, 0.0).unwrap();
+    assert_eq!(ph.roi.elements.len(), ph0.roi.elements.len());
+    let shift = 0.25 * p0.max_liver_shift;
+    let dist: Vec<f64> = ph0
+        .roi
+        .centroids
+        .iter()
+        .zip(&ph.roi.centroids)
+        .map(|(a, b)| {
+            ((b[0] - a[0]).powi(2) + (b[1] - (a[1] - shift)).powi(2) + (b[2] - a[2]).powi(2)).sqrt()
+        })
+        .collect();
+    let max = dist.iter().cloned().fold(0.0, f64::max);
+    let mean = dist.iter().sum::<f64>() / dist.len() as f64;
+    eprintln!("carried ROI: mean {mean:.4} m, max {max:.4} m");
+    assert!(max <= p0.voxel, "max {max} m");
+    assert!(mean <= 0.5 * p0.voxel, "mean {mean} m");
+    let set = &ph.mesh.element_sets["roi"];
+    assert!(ph.roi.elements.iter().all(|e| set.binary_search(e).is_ok()));
+}

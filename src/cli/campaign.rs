@@ -438,15 +438,21 @@ fn print_header(
 }
 
 fn print_plan(c: &Campaign, locs: &[phantom::Location], mine: &[&PlannedRun], done: &[bool]) {
+    // a respiratory campaign's phases; the liver depth is the reference phase's
+    let phase = |l: &campaign::CampaignLocation| match (c.is_respiratory(), l.phase) {
+        (false, _) => String::new(),
+        (true, p) => format!(" {:>5.3}", p.unwrap_or(c.base.respiratory_phase)),
+    };
+    let head = if c.is_respiratory() { " phase" } else { "" };
     println!(
-        "  {:<20} {:<8} {:<5} {:>8} {:>8} {:>8} {:>8} {:>9} {:>7}  state",
+        "  {:<20} {:<8} {:<5} {:>8} {:>8} {:>8} {:>8} {:>9} {:>7}{head}  state",
         "run", "location", "split", "x mm", "y mm", "liver mm", "depth mm", "time ms", "samples"
     );
     for (r, d) in mine.iter().zip(done) {
         let l = &c.locations[r.location];
         let s = &locs[r.location];
         println!(
-            "  {:<20} {:<8} {:<5} {:>8.1} {:>8.1} {:>8} {:>8.2} {:>9.2} {:>7}  {}",
+            "  {:<20} {:<8} {:<5} {:>8.1} {:>8.1} {:>8} {:>8.2} {:>9.2} {:>7}{}  {}",
             r.label,
             l.label,
             l.split.name(),
@@ -458,6 +464,7 @@ fn print_plan(c: &Campaign, locs: &[phantom::Location], mine: &[&PlannedRun], do
             r.depth * 1e3,
             r.duration * 1e3,
             c.samples_per_run(r),
+            phase(l),
             if *d { "done" } else { "to run" }
         );
     }

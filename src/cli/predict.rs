@@ -21,7 +21,7 @@
 //!   skipped. A closed stdout (the reader has gone) ends the stream quietly. The model is
 //!   loaded once ([`surrogate::Predictor`], the hand-written forward pass).
 
-use super::predict_line::{check_finite, parse_input_line};
+use super::predict_line::{check_finite, check_phase, parse_input_line};
 use serde_json::{json, Map, Value};
 use std::fmt::Write as _;
 use std::io::{BufRead, Write};
@@ -45,15 +45,21 @@ pub struct PredictArgs {
     /// Contact force [N] (a plain number, e.g. 20).
     #[arg(long, allow_negative_numbers = true, required_unless_present = "stdin")]
     pub force: Option<f64>,
+    /// Respiratory phase, 0 (exhalation) .. 1 (inspiration), for a model trained on a
+    /// respiratory campaign (its inputs end in `phase`); refused for one that takes x, y and
+    /// force only.
+    #[arg(long, allow_negative_numbers = true)]
+    pub phase: Option<f64>,
     /// Also render the 2-D map of the ROI stress (x-y projection of the ROI centroids) to this
     /// PNG file.
     #[arg(long)]
     pub png: Option<PathBuf>,
-    /// Stream instead: read JSON lines {"x": m, "y": m, "force": N, "id": optional} from stdin,
+    /// Stream instead: read JSON lines {"x": m, "y": m, "force": N, "phase": optional, "id":
+    /// optional} from stdin,
     /// write one JSON line per input, {"line": n, "id": .., "stress": [Pa, ...], "variance":
     /// Pa^2 or null (a GP's latent variance; on the tensor target, of each stress component)},
     /// flushed at once; a bad line gets {"line": n, "error": ".."} and the stream goes on.
-    #[arg(long, conflicts_with_all = ["x", "y", "force", "png"])]
+    #[arg(long, conflicts_with_all = ["x", "y", "force", "phase", "png"])]
     pub stdin: bool,
 }
 
@@ -62,7 +68,7 @@ pub fn predict(a: &PredictArgs) -> Result<(), String> {
     match (a.stdin, a.x, a.y, a.force) {
         (true, ..) => predict_stdin(&a.model),
         (false, Some(x), Some(y), Some(force)) => {
-            predict_one(&a.model, x, y, force, a.png.as_deref())
+            predict_one(&a.model, [x, y, force], a.phase, a.png.as_deref())
         }
         _ => Err("give --x, --y and --force, or --stdin".into()),
     }
@@ -111,29 +117,53 @@ fn non_finite_output(stress: &[f64], variance: Option<f64>) -> Result<(), String
     }
 }
 
+/// Set a model's respiratory phase; a phase given to a model without a phase input is refused,
+/// naming the model.
+fn apply_phase(
+    p: &mut surrogate::Predictor,
+    phase: Option<f64>,
+    model: &Path,
+) -> Result<(), String> {
+    let Some(v) = phase else { return Ok(()) };
+    let v = check_phase(v)?;
+    if !p.takes_phase() {
+        return Err(format!(
+            "model {}: it takes x, y and force only (trained without a respiratory phase); a phase needs a model trained on a respiratory campaign",
+            model.display()
+        ));
+    }
+    p.set_phase(v);
+    Ok(())
+}
+
 /// One-shot prediction: print the vector, optionally render the map.
 pub fn predict_one(
     model: &Path,
-    x: f64,
-    y: f64,
-    force: f64,
+    [x, y, force]: [f64; 3],
+    phase: Option<f64>,
     png: Option<&Path>,
 ) -> Result<(), String> {
     let x = check_finite("--x", x)?;
     let y = check_finite("--y", y)?;
     let force = check_finite("--force", force)?;
     let mut served = load_served(model)?;
+    apply_phase(&mut served.predictor, phase, model)?;
     let meta = served.predictor.meta().clone();
     let prediction = served.predict(x, y, force);
     let stress = &prediction.stress;
     non_finite_output(stress, None).map_err(|e| format!("model {}: {e}", model.display()))?;
     let mut text = format!(
-        "{} model {} on the {} target ({}): {} ROI elements\nfinger at x = {x} m, y = {y} m, force = {force} N\n",
+        "{} model {} on the {} target ({}): {} ROI elements\nfinger at x = {x} m, y = {y} m, force = {force} N{}\n",
         meta.kind,
         model.display(),
         meta.report.target,
         meta.report.size,
-        stress.len()
+        stress.len(),
+        if served.predictor.takes_phase() {
+            format!(", respiratory phase {}", served.predictor.phase())
+        } else {
+            String::new()
+        }
     );
     if let Some(sd) = prediction.sd {
         let of = match meta.report.target {
@@ -215,10 +245,12 @@ pub fn predict_stdin(model: &Path) -> Result<(), String> {
             Ok(Some(v)) => Ok(v),
             Err(e) => Err(e),
         };
-        let reply = match parsed.and_then(|([x, y, force], id)| {
+        let reply = match parsed.and_then(|line| {
+            let [x, y, force] = line.press;
+            apply_phase(&mut p, line.phase, model)?;
             let (stress, variance) = p.predict_with_variance(x, y, force);
-            non_finite_output(&stress, variance)?;
-            Ok((stress, variance, id))
+            non_finite_output(stress, variance)?;
+            Ok((stress.to_vec(), variance, line.id))
         }) {
             Ok((stress, variance, id)) => {
                 served += 1;

@@ -11,7 +11,8 @@
 //!   calibration (`--calibration`, `palpa calibrate`) to the body, the force filtered as the
 //!   training data's was ([`surrogate::sensor`]);
 //! - `--replay LOG.csv`: a recorded sensor log at its recorded speed;
-//! - the respiratory phase (ignored by models without it, which is every model so far).
+//! - the respiratory phase (a model trained on a respiratory campaign predicts at it; models
+//!   without a phase input ignore it).
 //!
 //! It binds to 127.0.0.1 by default; another `--bind` address is the user's explicit choice
 //! and is printed with a warning (there is no authentication). A bad message gets an error on

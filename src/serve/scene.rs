@@ -78,11 +78,11 @@ pub fn scene_json(p: &SceneParts, layout: &Layout) -> String {
             "kind": meta.kind.to_string(),
             "target": meta.report.target.to_string(),
             "inputs": inputs,
-            "units": {"x": "m", "y": "m", "force": "N", "stress": "Pa"},
+            "units": {"x": "m", "y": "m", "force": "N", "phase": "0 exhalation .. 1 inspiration", "stress": "Pa"},
             "roi_elements": meta.roi_ids.len(),
             "deviation": p.model.predictor.prior_deviation().is_some(),
             "prior_deviation_pa": p.model.predictor.prior_deviation(),
-            "takes_phase": inputs.contains(&"respiratory_phase"),
+            "takes_phase": p.model.predictor.takes_phase(),
             "test_fit": meta.report.test_fit,
         },
         "view": view.map(|v| json!({

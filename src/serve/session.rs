@@ -148,9 +148,11 @@ impl Session {
         Ok(self.frame(stamp))
     }
 
-    /// The respiratory phase (the models so far take x, y and force only, and ignore it).
+    /// The respiratory phase (0 exhalation .. 1 inspiration): a model trained on a respiratory
+    /// campaign predicts at it; one that takes x, y and force only ignores it.
     pub fn phase(&mut self, value: f64) -> String {
         self.phase = value;
+        self.model.predictor.set_phase(value);
         self.frame(None)
     }
 

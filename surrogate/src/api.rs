@@ -2,6 +2,7 @@
 
 use crate::coverage::{principal_variance_factor, Coverage, Z95};
 use crate::dataset::Dataset;
+use crate::dataset::MODEL_INPUTS;
 use crate::domain::TrainingDomain;
 use crate::error::{Error, Result};
 use crate::fit::{compute_fit, compute_fit_by_location};
@@ -11,7 +12,7 @@ use crate::model::{Predictor, PredictorImpl, TrainedModel};
 use crate::model_kind::ModelKind;
 use crate::report::{CostRow, EvaluationReport, LocationFit, TrainReport};
 use crate::target::{Target, TargetMap};
-use ndarray::{s, Array2, Axis};
+use ndarray::{Array2, Axis};
 use serde::{Deserialize, Serialize};
 use std::path::Path;
 use std::time::Instant;
@@ -259,8 +260,8 @@ fn fit_and_score(
     if train_rows.is_empty() {
         return Err(Error::invalid("split", "no training samples (split == 0)"));
     }
-    let x3 = data.x.slice(s![.., 0..3]);
-    let xt = x3.select(Axis(0), &train_rows);
+    let xin = data.model_inputs();
+    let xt = xin.select(Axis(0), &train_rows);
     let target = opts
         .target
         .unwrap_or_else(|| Target::default_for(kind, data));
@@ -305,14 +306,13 @@ fn fit_and_score(
     let mut pred = model.to_predictor();
     let mut map = TargetMap::new(target, data.n_roi());
     let mut yhat = Array2::zeros(data.y.dim());
-    for (i, mut row) in yhat.rows_mut().into_iter().enumerate() {
-        let xi = [x3[(i, 0)], x3[(i, 1)], x3[(i, 2)]];
+    for (mut row, xi) in yhat.rows_mut().into_iter().zip(xin.rows()) {
         row.assign(&ndarray::ArrayView1::from(
-            map.apply(pred.predict_inputs(&xi)),
+            map.apply(pred.predict_inputs(&xi.to_vec())),
         ));
     }
-    let test_coverage_95 = interval_coverage(&mut pred, target, data, &test_rows);
-    let latency_us = measure_latency(&mut pred, &mut map, &x3.select(Axis(0), &train_rows));
+    let test_coverage_95 = interval_coverage(&mut pred, target, data, &xin, &test_rows);
+    let latency_us = measure_latency(&mut pred, &mut map, &xt);
     let score = |rows: &[usize]| {
         compute_fit(
             data.y.select(Axis(0), rows).view(),
@@ -388,6 +388,7 @@ fn interval_coverage(
     pred: &mut PredictorImpl,
     target: Target,
     data: &Dataset,
+    inputs: &Array2<f64>,
     rows: &[usize],
 ) -> Option<f64> {
     let PredictorImpl::Gp(g) = pred else {
@@ -398,8 +399,7 @@ fn interval_coverage(
     let mut cov = Coverage::default();
     let mut var = vec![0.0; data.n_roi()];
     for &i in rows {
-        let xi = [data.x[(i, 0)], data.x[(i, 1)], data.x[(i, 2)]];
-        let (raw, latent) = g.predict_with_variance(&xi);
+        let (raw, latent) = g.predict_with_variance(&inputs.row(i).to_vec());
         let v = latent + noise;
         match target {
             Target::Principal => var.iter_mut().for_each(|w| *w = v),
@@ -425,9 +425,13 @@ fn measure_latency(pred: &mut PredictorImpl, map: &mut TargetMap, inputs: &Array
     let mut sink = 0.0;
     for k in 0..calls {
         let i = k % n;
-        let xi = [inputs[(i, 0)], inputs[(i, 1)], inputs[(i, 2)]];
+        let mut xi = [0.0; MODEL_INPUTS.len()];
+        let d = inputs.ncols().min(xi.len());
+        for (j, v) in xi.iter_mut().take(d).enumerate() {
+            *v = inputs[(i, j)];
+        }
         sink += map
-            .apply(pred.predict_inputs(&xi))
+            .apply(pred.predict_inputs(&xi[..d]))
             .first()
             .copied()
             .unwrap_or(0.0);

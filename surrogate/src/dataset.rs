@@ -121,7 +121,25 @@ pub fn dataset_paths(path: &Path) -> (PathBuf, PathBuf) {
     }
 }
 
+/// The inputs a model may take, in order: finger x [m], y [m], force [N] and, for a dataset
+/// with a `phase` column (a respiratory campaign), the respiratory phase (0 exhalation .. 1
+/// inspiration). A model takes the first three or all four.
+pub const MODEL_INPUTS: [&str; 4] = ["x", "y", "force", "phase"];
+
 impl Dataset {
+    /// The columns of `X` a model trains on: x, y, force, and `phase` when the dataset has one
+    /// ([`MODEL_INPUTS`]).
+    pub fn model_input_columns(&self) -> Vec<usize> {
+        let mut c = vec![0, 1, 2];
+        c.extend(self.manifest.x_columns.iter().position(|n| n == "phase"));
+        c
+    }
+
+    /// The model inputs of every row (n x 3, or n x 4 with a phase; [`Dataset::model_input_columns`]).
+    pub fn model_inputs(&self) -> Array2<f64> {
+        self.x.select(Axis(1), &self.model_input_columns())
+    }
+
     /// Number of samples n.
     pub fn n_samples(&self) -> usize {
         self.x.nrows()

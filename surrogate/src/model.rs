@@ -113,6 +113,15 @@ impl TrainedModel {
         }
     }
 
+    /// Number of inputs D: 3 (x, y, force) or 4 (and the respiratory phase), the first D of
+    /// [`crate::dataset::MODEL_INPUTS`].
+    pub fn n_inputs(&self) -> usize {
+        match self {
+            TrainedModel::Mlp(m) => m.input_scaling.len(),
+            TrainedModel::Gp(g) => g.input_scaling.len(),
+        }
+    }
+
     /// A serving predictor over this model (same arithmetic as after save and load). Its outputs
     /// are the raw ones (6R stress components on the tensor target); map them with
     /// `target::TargetMap` as [`Predictor`] does.
@@ -171,6 +180,7 @@ impl TrainedModel {
         domain: Option<&TrainingDomain>,
     ) -> Result<()> {
         let (st, js) = model_paths(path.as_ref());
+        let inputs = &crate::dataset::MODEL_INPUTS[..self.n_inputs().min(4)];
         if let Some(dir) = st.parent().filter(|d| !d.as_os_str().is_empty()) {
             std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, e))?;
         }
@@ -258,7 +268,7 @@ impl TrainedModel {
             format: MODEL_FORMAT.into(),
             version: MODEL_VERSION,
             kind: self.kind(),
-            input_columns: vec!["x".into(), "y".into(), "force".into()],
+            input_columns: inputs.iter().map(|c| c.to_string()).collect(),
             roi_ids: roi_ids.to_vec(),
             input_scaling,
             output_scaling,
@@ -273,8 +283,14 @@ impl TrainedModel {
             ("version", MODEL_VERSION.to_string()),
             ("kind", self.kind().to_string()),
             ("target", report.target.to_string()),
-            ("input_columns", r#"["x","y","force"]"#.to_string()),
-            ("input_units", r#"["m","m","N"]"#.to_string()),
+            (
+                "input_columns",
+                serde_json::to_string(inputs).unwrap_or_default(),
+            ),
+            (
+                "input_units",
+                serde_json::to_string(&["m", "m", "N", "1"][..inputs.len()]).unwrap_or_default(),
+            ),
             (
                 "output",
                 "maximum principal Cauchy stress of each ROI element".to_string(),
@@ -319,6 +335,9 @@ pub struct Predictor {
     roi_centroids: Array2<f64>,
     inner: PredictorImpl,
     map: TargetMap,
+    /// The respiratory phase a model with a `phase` input is evaluated at
+    /// ([`Predictor::set_phase`]).
+    phase: f64,
 }
 
 impl Predictor {
@@ -462,13 +481,33 @@ impl Predictor {
             roi_centroids,
             inner,
             map,
+            phase: 0.0,
         })
     }
 
-    /// ROI maximum principal stress [Pa] for a finger at (`x`, `y`) [m] pressing with `force` [N].
+    /// Whether the model takes the respiratory phase as a fourth input (trained on a
+    /// respiratory campaign).
+    pub fn takes_phase(&self) -> bool {
+        self.meta.input_columns.iter().any(|c| c == "phase")
+    }
+
+    /// The respiratory phase (0 exhalation .. 1 inspiration) at which later predictions are
+    /// made; 0 (the paper's frame) until set. A model without a phase input ignores it.
+    pub fn set_phase(&mut self, phase: f64) {
+        self.phase = phase;
+    }
+
+    /// The phase of [`Predictor::set_phase`].
+    pub fn phase(&self) -> f64 {
+        self.phase
+    }
+
+    /// ROI maximum principal stress [Pa] for a finger at (`x`, `y`) [m] pressing with `force` [N]
+    /// (at the phase of [`Predictor::set_phase`] for a model that takes one).
     /// Allocation-free; the slice is valid until the next call.
     pub fn predict(&mut self, x: f64, y: f64, force: f64) -> &[f64] {
-        self.map.apply(self.inner.predict_inputs(&[x, y, force]))
+        let inputs = [x, y, force, self.phase];
+        self.map.apply(self.inner.predict_inputs(&inputs))
     }
 
     /// Like [`Predictor::predict`], plus the GP's predictive (latent) variance [Pa^2], shared
@@ -477,10 +516,10 @@ impl Predictor {
     pub fn predict_with_variance(&mut self, x: f64, y: f64, force: f64) -> (&[f64], Option<f64>) {
         let (raw, var) = match &mut self.inner {
             PredictorImpl::Gp(g) => {
-                let (m, v) = g.predict_with_variance(&[x, y, force]);
+                let (m, v) = g.predict_with_variance(&[x, y, force, self.phase]);
                 (m, Some(v))
             }
-            PredictorImpl::Mlp(m) => (m.predict_inputs(&[x, y, force]), None),
+            PredictorImpl::Mlp(m) => (m.predict_inputs(&[x, y, force, self.phase]), None),
         };
         (self.map.apply(raw), var)
     }
