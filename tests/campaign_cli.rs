@@ -585,6 +585,18 @@ fn respiratory_campaign_adds_the_phase_as_an_input() {
     let o = at(&model, "1.5");
     assert!(!o.status.success());
     assert!(String::from_utf8_lossy(&o.stderr).contains("phase = 1.5 is outside 0"));
+    let blind = tmp.path().join("blind");
+    ok(&[
+        "train",
+        s(&breath),
+        "--model",
+        "gp",
+        "--ignore-phase",
+        "--out",
+        s(&blind),
+    ]);
+    let meta = std::fs::read_to_string(blind.join("model.json")).unwrap();
+    assert!(!meta.contains("\"phase\""), "{meta}");
     let flat = tmp.path().join("flat");
     ok(&["train", s(&plain), "--model", "gp", "--out", s(&flat)]);
     let o = at(&flat, "0.5");

@@ -117,6 +117,7 @@ pub fn run(a: &FrontArgs) -> Result<(), String> {
                 first_locations: Some(n),
                 interval,
                 recovery_width,
+                ignore_phase: a.target.ignore_phase,
             };
             let row = point(name, dir, &data, &order[..n], &selection)?;
             println!(
@@ -190,7 +191,12 @@ fn point(
     let (abc, other): (Vec<usize>, Vec<usize>) = sel
         .rows_with_split(Split::Test)
         .into_iter()
-        .partition(|&i| ["A", "B", "C"].contains(&sel.location_label(sel.location[i]).as_str()));
+        .partition(|&i| {
+            // a respiratory campaign's A at a phase is `A-ph0.5`
+            let label = sel.location_label(sel.location[i]);
+            let place = label.split("-ph").next().unwrap_or_default();
+            ["A", "B", "C"].contains(&place)
+        });
     let score = |rows: &[usize]| {
         (!rows.is_empty()).then(|| {
             let pick = |a: &ndarray::Array2<f64>| a.select(ndarray::Axis(0), rows);

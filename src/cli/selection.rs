@@ -16,6 +16,10 @@ pub struct SampleTargetArgs {
     /// recovered field (docs/surrogate.md).
     #[arg(long, value_name = "LENGTH")]
     pub recover: Option<String>,
+    /// Train on x, y and force only, without a respiratory dataset's phase input (what the
+    /// phase buys, on the same runs; the held-out samples are scored either way).
+    #[arg(long)]
+    pub ignore_phase: bool,
 }
 
 impl SampleTargetArgs {

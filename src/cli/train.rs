@@ -217,6 +217,7 @@ pub fn train(a: &TrainArgs) -> Result<(), String> {
         first_locations: a.train_locations,
         interval,
         recovery_width,
+        ignore_phase: a.sample_target.ignore_phase,
     };
     let report = surrogate::train_selected(&a.dataset, &selection, kind, &opts, &a.out)
         .map_err(|e| format!("train {}: {e}", a.dataset.display()))?;

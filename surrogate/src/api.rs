@@ -75,12 +75,18 @@ pub struct TrainingSelection {
     /// Learn the recovered stress target of this width (m; [`crate::recovery`]) instead of the
     /// element stress.
     pub recovery_width: Option<f64>,
+    /// Drop a respiratory dataset's `phase` column, so that the model takes x, y and force
+    /// only (what the phase input buys, measured on the same runs).
+    pub ignore_phase: bool,
 }
 
 impl TrainingSelection {
     /// The dataset this selection trains on: its training samples, and its target.
     pub fn apply(&self, data: &Dataset) -> Result<Dataset> {
-        let d = data.select_training(self.first_locations, self.interval)?;
+        let mut d = data.select_training(self.first_locations, self.interval)?;
+        if self.ignore_phase {
+            d = d.without_column("phase");
+        }
         match self.recovery_width {
             Some(h) => d.recovered(h),
             None => Ok(d),

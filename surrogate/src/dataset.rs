@@ -135,6 +135,16 @@ impl Dataset {
         c
     }
 
+    /// The dataset without the `X` column `name` (unchanged when it has none).
+    pub fn without_column(mut self, name: &str) -> Dataset {
+        if let Some(k) = self.manifest.x_columns.iter().position(|c| c == name) {
+            let keep: Vec<usize> = (0..self.x.ncols()).filter(|&c| c != k).collect();
+            self.x = self.x.select(Axis(1), &keep);
+            self.manifest.x_columns.remove(k);
+        }
+        self
+    }
+
     /// The model inputs of every row (n x 3, or n x 4 with a phase; [`Dataset::model_input_columns`]).
     pub fn model_inputs(&self) -> Array2<f64> {
         self.x.select(Axis(1), &self.model_input_columns())
