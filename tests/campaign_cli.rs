@@ -19,7 +19,8 @@
 //!   and a bad key is an error naming it;
 //! - a respiratory campaign (`[locations] phases`) has the phase as its sixth input column,
 //!   reads each run's ROI through the points carried with the liver, and at the reference
-//!   phase gives the plain campaign's numbers bit for bit; its model takes the phase.
+//!   phase gives the plain campaign's numbers bit for bit; its model takes the phase (in
+//!   `palpa predict --phase` and in `palpa serve`'s phase message).
 
 use std::path::Path;
 use std::process::{Command, Stdio};
@@ -29,6 +30,8 @@ use surrogate::{Dataset, ViewGeometry};
 #[path = "support/cli.rs"]
 mod cli;
 use cli::{ok, palpa, s};
+#[path = "support/mod.rs"]
+mod serve_support;
 #[path = "support/tiny_campaign.rs"]
 mod tiny_campaign;
 use tiny_campaign::{done_count, tiny, RUNS, SAMPLES, TINY};
@@ -585,6 +588,29 @@ fn respiratory_campaign_adds_the_phase_as_an_input() {
     let o = at(&model, "1.5");
     assert!(!o.status.success());
     assert!(String::from_utf8_lossy(&o.stderr).contains("phase = 1.5 is outside 0"));
+    // served: the phase message reaches the model, and the liver is drawn where it moves
+    let server = serve_support::Server::start(&model, &[]);
+    let mut screen = server.connect();
+    screen.next_of("frame");
+    let fmax = d.x.column(2).fold(0.0f64, |a, &b| a.max(b));
+    let press = format!(
+        r#"{{"type":"pointer","x":{},"y":{},"force":{fmax}}}"#,
+        xy[0], xy[1]
+    );
+    screen.send(&press);
+    let at0 = screen.next_of("frame");
+    screen.send(r#"{"type":"phase","value":0.5}"#);
+    let at5 = screen.next_of("frame");
+    assert_eq!(at0["liver_shift"], 0.0);
+    assert!(
+        (at5["liver_shift"].as_f64().unwrap() - 0.01).abs() < 1e-12,
+        "{at5}"
+    );
+    assert_ne!(
+        at0["stress"], at5["stress"],
+        "the phase does not reach the model"
+    );
+    drop(server);
     let blind = tmp.path().join("blind");
     ok(&[
         "train",

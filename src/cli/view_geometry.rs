@@ -52,6 +52,7 @@ pub fn from_phantom(
         roi_cells,
         fingers,
         respiratory_phase: ph.params.respiratory_phase,
+        max_liver_shift_m: ph.params.max_liver_shift,
     };
     view.validate()
         .map_err(|e| format!("internal: plan view: {e}"))?;

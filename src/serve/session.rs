@@ -156,6 +156,17 @@ impl Session {
         self.frame(None)
     }
 
+    /// How far [m] the liver and its ROI are drawn caudally of the view's outlines: the phase's
+    /// shift for a model with a phase input and a `view.json`, else 0.
+    fn liver_shift(&self) -> f64 {
+        match &self.model.view {
+            Some(v) if self.model.predictor.takes_phase() => {
+                (self.phase - v.respiratory_phase) * v.max_liver_shift_m
+            }
+            _ => 0.0,
+        }
+    }
+
     /// The frame of the current state (for a screen that has just connected).
     pub fn current(&mut self) -> String {
         self.frame(None)
@@ -196,6 +207,7 @@ impl Session {
             "force": force,
             "lifted": self.lifted,
             "phase": self.phase,
+            "liver_shift": self.liver_shift(),
             "plate": self.plate,
             "stress": stress,
             "sd": served.sd,

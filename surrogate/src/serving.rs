@@ -183,6 +183,7 @@ mod tests {
                 .collect(),
             fingers: Fingers::default(),
             respiratory_phase: 0.0,
+            max_liver_shift_m: 0.02,
         };
         view.write(&view_path(&model)).unwrap();
         let mut m = ServedModel::load(&model).unwrap();

@@ -18,7 +18,8 @@
 //!   "roi_ids": [...],                  // the model's ROI element ids, in its order
 //!   "roi_cells": [[[x, y], ...], ...], // each ROI element's plan footprint, same order
 //!   "fingers": {"spacing_m": 0.02, "diameter_m": 0.015, "axis": [1, 0]},
-//!   "respiratory_phase": 0.0
+//!   "respiratory_phase": 0.0,
+//!   "max_liver_shift_m": 0.02          // the liver's caudal shift at phase 1
 //! }
 //! ```
 //!
@@ -103,6 +104,16 @@ pub struct ViewGeometry {
     /// Respiratory phase of the phantom the outlines were drawn at (0 exhalation, 1 inspiration).
     #[serde(default)]
     pub respiratory_phase: f64,
+    /// The liver's caudal shift at phase 1 (m): a model with a phase input is drawn with the
+    /// liver and its ROI moved by `(phase - respiratory_phase) * max_liver_shift_m`.
+    #[serde(default = "default_liver_shift")]
+    pub max_liver_shift_m: f64,
+}
+
+/// The phantom's default [`ViewGeometry::max_liver_shift_m`], for a `view.json` written before
+/// it was recorded.
+fn default_liver_shift() -> f64 {
+    0.02
 }
 
 /// The `view.json` path of the model at `model` (see the module doc).
@@ -322,6 +333,7 @@ mod tests {
             roi_cells: vec![square([-0.05, 0.2], 0.0015), square([-0.04, 0.2], 0.0015)],
             fingers: Fingers::default(),
             respiratory_phase: 0.0,
+            max_liver_shift_m: 0.02,
         }
     }
 

@@ -90,8 +90,11 @@ const palpa = (() => {
     if (v) {
       c.fillStyle = rgb(pal.torso);
       path(c, v.torso); c.fill();
-      c.fillStyle = rgb(pal.liver_fill);
-      v.liver.forEach((l) => { path(c, l); c.fill(); });
+      // a model with a phase input draws the liver where the phase moves it (draw())
+      if (!scene.model.takes_phase) {
+        c.fillStyle = rgb(pal.liver_fill);
+        v.liver.forEach((l) => { path(c, l); c.fill(); });
+      }
       c.fillStyle = rgb(pal.rib_fill);
       c.strokeStyle = rgb(pal.rib_line);
       c.lineWidth = 1;
@@ -137,6 +140,13 @@ const palpa = (() => {
     ctx.setTransform(dpr, 0, 0, dpr, 0, 0);
     const pal = scene.palette;
     if (devImage && el("deviation").checked) drawDeviation();
+    // the liver and its ROI move caudally (down the page) with the respiratory phase
+    ctx.save();
+    ctx.translate(0, frame && frame.liver_shift ? frame.liver_shift * tf.s : 0);
+    if (scene.model.takes_phase) {
+      ctx.fillStyle = rgb(pal.liver_fill);
+      paths.liver.forEach((l) => ctx.fill(l));
+    }
     if (frame) {
       // cells by rising stress: where elements overlap in plan, the largest shows
       const s = frame.stress;
@@ -149,6 +159,7 @@ const palpa = (() => {
     ctx.strokeStyle = rgb(pal.liver_line);
     ctx.lineWidth = 2;
     paths.liver.forEach((l) => ctx.stroke(l));
+    ctx.restore();
     if (paths.hull) {
       ctx.setLineDash([1, 4]);
       ctx.strokeStyle = rgb(pal.hull);
