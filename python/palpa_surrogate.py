@@ -12,7 +12,9 @@ numbers: the MLP's layers run in float32 and add their rows one input at a time,
 largest eigenvalue uses palpa's polynomial of the trigonometric solution. ``exp`` is numpy's
 rather than Rust's, so a GP can differ in the last bit; the test allows 1e-6 relative.
 
-Inputs are SI (m, m, N) in the dataset's frame; outputs are the maximum principal Cauchy stress
+Inputs are SI (m, m, N) in the dataset's frame, and for a model trained on a respiratory
+campaign (``input_columns`` ending in ``phase``) the respiratory phase, 0 .. 1
+(``s.predict(x, y, force, phase)``); outputs are the maximum principal Cauchy stress
 of each ROI element in Pa. Only numpy is needed. The file formats:
 
 - ``model.safetensors``: an 8-byte little-endian header length, a JSON header (tensor name ->
@@ -173,9 +175,16 @@ class Surrogate:
         else:
             raise ValueError(f"{js}: kind {self.kind!r}, expected mlp or gp")
 
-    def raw(self, x, y, force):
+    def takes_phase(self):
+        """Whether the model takes the respiratory phase (trained on a respiratory campaign)."""
+        return "phase" in self.input_columns
+
+    def raw(self, x, y, force, phase=None):
         """The model's raw outputs (R, or 6R stress components on the tensor target), Pa."""
-        inputs = np.array([x, y, force], dtype=np.float64)
+        if phase is not None and not self.takes_phase():
+            raise ValueError("this model takes x, y and force only: no phase")
+        inputs = np.array([x, y, force, 0.0 if phase is None else phase], dtype=np.float64)
+        inputs = inputs[: len(self.input_columns)]
         u = (inputs - self.in_mean) / self.in_std
         if self.kind == "mlp":
             a = u.astype(np.float32)
@@ -210,9 +219,11 @@ class Surrogate:
             out = out32.astype(np.float64)
         return out * self.out_std + self.out_mean
 
-    def predict(self, x, y, force):
-        """ROI maximum principal stress [Pa] for a finger at x, y [m] pressing with force [N]."""
-        raw = self.raw(x, y, force)
+    def predict(self, x, y, force, phase=None):
+        """ROI maximum principal stress [Pa] for a finger at x, y [m] pressing with force [N],
+        at the respiratory phase (0 exhalation .. 1 inspiration; 0 when not given) for a model
+        that takes one."""
+        raw = self.raw(x, y, force, phase)
         if self.target == "tensor":
             return max_principal(raw.reshape(-1, 6))
         return raw
@@ -226,9 +237,10 @@ def main(argv):
     ap.add_argument("--x", type=float, required=True, help="finger x [m]")
     ap.add_argument("--y", type=float, required=True, help="finger y [m]")
     ap.add_argument("--force", type=float, required=True, help="force [N]")
+    ap.add_argument("--phase", type=float, help="respiratory phase, 0 .. 1 (a model that takes one)")
     a = ap.parse_args(argv)
     s = Surrogate(a.model)
-    stress = s.predict(a.x, a.y, a.force)
+    stress = s.predict(a.x, a.y, a.force, a.phase)
     print(f"{s.kind} model {a.model} on the {s.target} target: {len(stress)} ROI elements")
     print("element_id stress_Pa")
     for i, v in zip(s.roi_ids, stress):

@@ -4,7 +4,8 @@
     python python/test_palpa_surrogate.py CAMPAIGN_DIR MODEL_DIR... [--palpa target/release/palpa]
 
 For each model (an MLP, a GP on the principal stress, a GP on the stress tensor, ...), the
-inputs are the campaign's own samples (CAMPAIGN_DIR/dataset.npz, columns x, y, force) and as
+inputs are the campaign's own samples (CAMPAIGN_DIR/dataset.npz, columns x, y, force, and
+phase for a respiratory campaign) and as
 many points drawn inside their range; `palpa predict MODEL --stdin` answers them all (its JSON
 numbers are shortest round-trip decimals, i.e. the exact binary values), and
 `palpa_surrogate.Surrogate.predict` must agree with every ROI value to 1e-6 of the largest
@@ -36,12 +37,16 @@ def main():
     ap.add_argument("models", nargs="+")
     ap.add_argument("--palpa", default=os.path.join("target", "release", "palpa"))
     a = ap.parse_args()
-    x = np.load(os.path.join(a.campaign, "dataset.npz"))["X"][:, :3]
+    # a respiratory campaign's models take the phase as a fourth input
+    with open(os.path.join(a.campaign, "manifest.json")) as f:
+        columns = json.load(f)["x_columns"]
+    names = ["x", "y", "force"] + (["phase"] if "phase" in columns else [])
+    x = np.load(os.path.join(a.campaign, "dataset.npz"))["X"][:, [columns.index(n) for n in names]]
     rng = np.random.default_rng(7)
     lo, hi = x.min(axis=0), x.max(axis=0)
-    inputs = np.vstack([x, lo + (hi - lo) * rng.random((len(x), 3))])
+    inputs = np.vstack([x, lo + (hi - lo) * rng.random(x.shape)])
     lines = "".join(
-        json.dumps({"x": float(p[0]), "y": float(p[1]), "force": float(p[2]), "id": i}) + "\n"
+        json.dumps({**{n: float(v) for n, v in zip(names, p)}, "id": i}) + "\n"
         for i, p in enumerate(inputs)
     )
     for model in a.models:
@@ -51,8 +56,8 @@ def main():
             ("kind", s.kind),
             ("target", s.target),
             ("version", str(s.meta["version"])),
-            ("input_columns", json.dumps(["x", "y", "force"], separators=(",", ":"))),
-            ("input_units", json.dumps(["m", "m", "N"], separators=(",", ":"))),
+            ("input_columns", json.dumps(names, separators=(",", ":"))),
+            ("input_units", json.dumps(["m", "m", "N", "1"][: len(names)], separators=(",", ":"))),
             ("output_unit", "Pa"),
         ):
             if meta.get(key) != want:
@@ -83,7 +88,7 @@ def main():
             exact += int(np.array_equal(got, want))
             if d > TOL:
                 fail(
-                    f"{model}: at x = {p[0]}, y = {p[1]}, force = {p[2]} the loader differs from "
+                    f"{model}: at {dict(zip(names, p))} the loader differs from "
                     f"palpa predict by {d:.3e} of the largest stress (tolerance {TOL})"
                 )
         print(

@@ -433,6 +433,14 @@ fn shipped_profiles_resolve_and_bad_keys_are_named() {
         assert_eq!(xy(table, 'T'), xy(&sobol3, 'T'));
     }
     assert_eq!(xy(&adaptive3, 'S'), s3[..10]);
+    // the respiratory design: Sobol over (x, y, phase), whose (x, y) are the plain design's
+    let breath = dry_run("campaign-respiration-5mm.toml");
+    assert!(
+        breath.contains("221 runs (221 locations: 200 train, 21 test)")
+            && breath.contains(" phase "),
+        "{breath}"
+    );
+    assert_eq!(xy(&breath, 'S')[..100], s5[..]);
     fails_naming("[indentation]\ndepht = \"5 mm\"\n", "depht");
     fails_naming(
         "[[locations.design]]\nkind = \"halton\"\nn = 4\nseed = 1\nsplit = \"train\"\n",

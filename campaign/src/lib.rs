@@ -32,6 +32,8 @@
 //! train = ["grid"]                 # "grid" = P01..P25; names A, B, C, P01..P25;
 //!                                  # points ["-50 mm", "190 mm"]; { name = "D", at = [x, y] }
 //! test = ["A", "B", "C"]
+//! # phases = [0.0, 0.5, 1.0]       # respiratory phases: each location (without a phase of its
+//!                                  # own) at each, labelled A-ph0, A-ph0.5, ... (module `plan`)
 //! [[locations.raster]]             # optional further rasters of points (x, y of the skin)
 //! center = ["-50 mm", "195 mm"]
 //! spacing = ["10 mm", "10 mm"]
@@ -46,6 +48,7 @@
 //! prefix = "S"                     # names S01, S02, ... (default S sobol, L lhs, U random)
 //! # extent = [["-100 mm", "165 mm"], ["0 mm", "225 mm"]]   # the default: the ROI's plan extent
 //! # polygon = [["-100 mm", "165 mm"], ["0 mm", "165 mm"], ["-50 mm", "225 mm"]]   # not lhs
+//! # phase = [0.0, 1.0]             # a design over (x, y, phase): each point its own phase
 //!
 //! [indentation]
 //! depth = "15 mm"                  # one value or a list: every depth is run
