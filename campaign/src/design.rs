@@ -119,7 +119,7 @@ impl DesignSpec {
             return Ok(drawn.into_iter().map(|(_, p)| (p, None)).collect());
         };
         for p in [lo, hi] {
-            crate::spec::check_phase(p, "locations.design.phase")?;
+            crate::phase::check_phase(p, "locations.design.phase")?;
         }
         if lo > hi {
             return Err(format!(

@@ -87,6 +87,7 @@ mod label;
 mod merge;
 mod outcome;
 mod phantom_record;
+mod phase;
 mod plan;
 mod run_files;
 mod shard;

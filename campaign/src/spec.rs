@@ -3,6 +3,7 @@
 
 use crate::design::DesignSpec;
 use crate::label::check_label;
+use crate::phase::check_phase;
 use crate::plan::{Campaign, CampaignLocation, PlannedRun, Split};
 use material::quantity::{Length, Number, Time, Velocity};
 use phantom::PAPER_VOXEL;
@@ -575,17 +576,6 @@ fn cross_phases(
         }
     }
     Ok(out)
-}
-
-/// A respiratory phase: finite, 0 (exhalation) .. 1 (inspiration).
-pub fn check_phase(p: f64, key: &str) -> Result<(), String> {
-    if (0.0..=1.0).contains(&p) {
-        Ok(())
-    } else {
-        Err(format!(
-            "{key}: phase {p} is outside 0 (exhalation) .. 1 (inspiration)"
-        ))
-    }
 }
 
 /// The runs: locations x depths x timings, in that order, within [`MAX_RUNS`] and the sample
