@@ -183,6 +183,8 @@ class Surrogate:
         """The model's raw outputs (R, or 6R stress components on the tensor target), Pa."""
         if phase is not None and not self.takes_phase():
             raise ValueError("this model takes x, y and force only: no phase")
+        if phase is not None and not 0.0 <= phase <= 1.0:
+            raise ValueError(f"phase = {phase} is outside 0 (exhalation) .. 1 (inspiration)")
         inputs = np.array([x, y, force, 0.0 if phase is None else phase], dtype=np.float64)
         inputs = inputs[: len(self.input_columns)]
         u = (inputs - self.in_mean) / self.in_std

@@ -565,9 +565,15 @@ fn respiratory_campaign_adds_the_phase_as_an_input() {
     assert_eq!(map("A-ph0"), p.roi_ids.to_vec());
     assert_eq!(map("A-ph1").len(), p.n_roi());
     assert_ne!(map("A-ph1"), p.roi_ids.to_vec());
-    // the model takes the phase; the plain one refuses it
-    let model = tmp.path().join("gp");
-    ok(&["train", s(&breath), "--model", "gp", "--out", s(&model)]);
+    phase_model_takes_the_phase(tmp.path(), &breath, &plain, &d);
+}
+
+/// The respiratory campaign's model takes the phase (`palpa predict --phase`, `--stdin` lines
+/// with and without `"phase"`, `palpa serve`'s phase message); `--ignore-phase` and the plain
+/// campaign's model take x, y and force only, and refuse a phase.
+fn phase_model_takes_the_phase(tmp: &Path, breath: &Path, plain: &Path, d: &Dataset) {
+    let model = tmp.join("gp");
+    ok(&["train", s(breath), "--model", "gp", "--out", s(&model)]);
     let meta = std::fs::read_to_string(model.join("model.json")).unwrap();
     assert!(
         meta.contains(
@@ -596,6 +602,38 @@ fn respiratory_campaign_adds_the_phase_as_an_input() {
     let o = at(&model, "1.5");
     assert!(!o.status.success());
     assert!(String::from_utf8_lossy(&o.stderr).contains("phase = 1.5 is outside 0"));
+    // --stdin: a line without "phase" is at phase 0, not the line before's
+    let stream = |m: &Path, lines: &str| -> Vec<serde_json::Value> {
+        let mut child = Command::new(env!("CARGO_BIN_EXE_palpa"))
+            .args(["predict", s(m), "--stdin"])
+            .stdin(Stdio::piped())
+            .stdout(Stdio::piped())
+            .spawn()
+            .unwrap();
+        use std::io::Write as _;
+        child
+            .stdin
+            .take()
+            .unwrap()
+            .write_all(lines.as_bytes())
+            .unwrap();
+        let out = child.wait_with_output().unwrap();
+        String::from_utf8_lossy(&out.stdout)
+            .lines()
+            .map(|l| serde_json::from_str(l).unwrap())
+            .collect()
+    };
+    let line = |phase: &str| {
+        format!(
+            "{{\"x\": {}, \"y\": {}, \"force\": 20{phase}}}\n",
+            xy[0], xy[1]
+        )
+    };
+    let lines = [line(", \"phase\": 1"), line(""), line(", \"phase\": 0")].concat();
+    let r = stream(&model, &lines);
+    assert_eq!(r.len(), 3, "{r:?}");
+    assert_eq!(r[1]["stress"], r[2]["stress"]);
+    assert_ne!(r[0]["stress"], r[1]["stress"]);
     // served: the phase message reaches the model, and the liver is drawn where it moves
     let server = serve_support::Server::start(&model, &[]);
     let mut screen = server.connect();
@@ -619,10 +657,10 @@ fn respiratory_campaign_adds_the_phase_as_an_input() {
         "the phase does not reach the model"
     );
     drop(server);
-    let blind = tmp.path().join("blind");
+    let blind = tmp.join("blind");
     ok(&[
         "train",
-        s(&breath),
+        s(breath),
         "--model",
         "gp",
         "--ignore-phase",
@@ -631,12 +669,15 @@ fn respiratory_campaign_adds_the_phase_as_an_input() {
     ]);
     let meta = std::fs::read_to_string(blind.join("model.json")).unwrap();
     assert!(!meta.contains("\"phase\""), "{meta}");
-    let flat = tmp.path().join("flat");
-    ok(&["train", s(&plain), "--model", "gp", "--out", s(&flat)]);
+    let flat = tmp.join("flat");
+    ok(&["train", s(plain), "--model", "gp", "--out", s(&flat)]);
     let o = at(&flat, "0.5");
     let err = String::from_utf8_lossy(&o.stderr);
     assert!(
         !o.status.success() && err.contains("takes x, y and force only"),
         "{err}"
     );
+    let r = stream(&flat, &line(", \"phase\": 0.5"));
+    let e = r[0]["error"].as_str().unwrap_or_default();
+    assert!(e.contains("takes x, y and force only"), "{r:?}");
 }

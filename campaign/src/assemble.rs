@@ -49,7 +49,7 @@ pub fn assemble(
         location: Vec::new(),
         split: Vec::new(),
     };
-    let respiratory = plan.locations.iter().any(|l| l.phase.is_some());
+    let respiratory = plan.is_respiratory();
     let cols = if respiratory { 6 } else { 5 };
     let mut run_rows = Vec::new();
     for label in labels {
@@ -68,7 +68,7 @@ pub fn assemble(
         let start = rows.location.len();
         let dir = dir_of(label);
         let ids = match loc.phase {
-            Some(_) => carried_roi(&dir)?,
+            Some(_) => carried_roi(&dir, r)?,
             None => roi_ids.clone(),
         };
         let phase = respiratory.then(|| loc.phase.unwrap_or(plan.phantom.respiratory_phase));
@@ -95,8 +95,8 @@ pub fn assemble(
     })
 }
 
-/// The element ids of a respiratory run's carried ROI, in the ROI's order.
-fn carried_roi(dir: &Path) -> Result<Vec<i64>, String> {
+/// The element ids of a respiratory run's carried ROI, in the ROI's order (`r` of them).
+fn carried_roi(dir: &Path, r: usize) -> Result<Vec<i64>, String> {
     let path = dir.join(crate::plan::ROI_MAP_FILE);
     let text = std::fs::read_to_string(&path)
         .map_err(|e| format!("{}: cannot read the run's ROI map: {e}", path.display()))?;
@@ -106,6 +106,14 @@ fn carried_roi(dir: &Path) -> Result<Vec<i64>, String> {
         roi_elements: Vec<i64>,
     }
     let m: RoiMap = serde_json::from_str(&text).map_err(|e| format!("{}: {e}", path.display()))?;
+    if m.roi_elements.len() != r {
+        return Err(format!(
+            "{}: {} ROI elements, the campaign's ROI has {r}: remove {} and continue with --resume to redo the run",
+            path.display(),
+            m.roi_elements.len(),
+            dir.display()
+        ));
+    }
     Ok(m.roi_elements)
 }
 
@@ -132,8 +140,9 @@ fn append_run(
         .filter(|_| d.elements.len() == distinct.len())
         .ok_or_else(|| {
             format!(
-                "{}: the probe's elements are not the campaign's ROI",
-                dir.display()
+                "{}: the probe's elements are not the campaign's ROI (for a run at a phase of its own: not those of its {})",
+                dir.display(),
+                crate::plan::ROI_MAP_FILE
             )
         })?;
     let at = loc.surface_m;

@@ -6,7 +6,9 @@
 //! [`PlannedRun`]s, the product of locations x depths x durations in a fixed order. On its built
 //! phantom it has a [`CampaignPlan`], which `campaign.json` records. Every run is an ordinary
 //! palpation ([`scene::palpation::PalpationSetup`]), built in memory, its `scene.toml` written
-//! into its own directory `DIR/runs/<label>/` and run there ([`execute`]); a run is finished
+//! into its own directory `DIR/runs/<label>/` and run there ([`execute`]; a run at a respiratory
+//! phase of its own reads the campaign's ROI through the points carried with the liver, which its
+//! `scene.toml` alone does not reproduce, see [`Campaign::build_run_scene`]); a run is finished
 //! when its `done.json` ([`DoneMarker`]) exists, written atomically after everything else. A
 //! directory without it is an interrupted or failed run and is redone from scratch. The
 //! finished runs make the dataset ([`assemble`]); the shards of a campaign join by [`merge`].

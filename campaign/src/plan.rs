@@ -125,7 +125,8 @@ impl Campaign {
     /// it with the liver ([`Phantom::carry_roi_from`]) and writes the carried element ids, in
     /// the ROI's order, to [`ROI_MAP_FILE`]; a named location (A, B, ...) is pressed at the
     /// reference phantom's skin point, so that it stays one place of the body while the liver
-    /// moves under it.
+    /// moves under it. The run's `scene.toml` names the phase, so `palpa run` on it rebuilds
+    /// that phantom, but with the phase's own ROI, not the carried one.
     pub fn build_run_scene(
         &self,
         r: &PlannedRun,
@@ -352,6 +353,11 @@ impl CampaignPlan {
     pub fn from_value(v: &serde_json::Value) -> Result<CampaignPlan, String> {
         serde_path_to_error::deserialize(v)
             .map_err(|e| format!("the plan: {}", crate::phantom_record::at_key(&e)))
+    }
+
+    /// Whether some location is pressed at a phase of its own ([`Campaign::is_respiratory`]).
+    pub fn is_respiratory(&self) -> bool {
+        self.locations.iter().any(|l| l.phase.is_some())
     }
 
     /// The run labelled `label`.

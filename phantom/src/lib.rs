@@ -261,9 +261,7 @@ pub fn build(p: &PhantomParams) -> Result<Phantom, String> {
     let gx = p.grid.center[0];
     let center = p.roi.center.unwrap_or_else(|| an.liver_edge_point(gx));
     let roi = select_roi(&mesh, &organ, center, &p.roi);
-    let mut rs = roi.elements.clone();
-    rs.sort_unstable();
-    mesh.element_sets.insert("roi".into(), rs);
+    mesh.element_sets.insert("roi".into(), roi.element_set());
 
     let search = if (p.voxel - TEST_SEARCH_VOXEL).abs() > 1e-12 {
         Some(label_volume(&PhantomParams {
@@ -317,10 +315,9 @@ impl Phantom {
         let organ = organ_parts(&self.mesh.part_names);
         let roi = carry_roi(&self.mesh, &organ, reference, d)
             .ok_or("the phantom has no liver surface to carry the ROI onto")?;
-        let mut rs = roi.elements.clone();
-        rs.sort_unstable();
-        rs.dedup();
-        self.mesh.element_sets.insert("roi".into(), rs);
+        self.mesh
+            .element_sets
+            .insert("roi".into(), roi.element_set());
         self.roi = roi;
         Ok(())
     }

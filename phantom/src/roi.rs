@@ -9,7 +9,8 @@
 //! and the voxel mesh of another phase has other elements. [`carry_roi`] keeps one ROI's
 //! material points: each reference centroid `c_i`, moved with the liver to `c_i + d`, is read
 //! from the organ-surface element of the new mesh whose centroid is nearest, so that column
-//! `i` of every phase's ROI is the same point of the liver (to half a voxel).
+//! `i` of every phase's ROI is the same point of the liver (within a voxel, half a voxel on
+//! average on the 8 mm test phantom).
 
 use std::collections::HashMap;
 
@@ -30,6 +31,14 @@ pub struct Roi {
 }
 
 impl Roi {
+    /// The ROI's element ids sorted, each once: the mesh's element set `roi`.
+    pub fn element_set(&self) -> Vec<u32> {
+        let mut s = self.elements.clone();
+        s.sort_unstable();
+        s.dedup();
+        s
+    }
+
     /// JSON text of the ROI.
     pub fn to_json(&self) -> String {
         serde_json::to_string_pretty(self).unwrap_or_default()

@@ -2,7 +2,9 @@
 //! serve a saved surrogate.
 //!
 //! Inputs are SI: the finger position x, y in metres (the dataset's frame) and the contact force
-//! in newtons; outputs are the maximum principal stress of each ROI element in pascals.
+//! in newtons, and for a model trained on a respiratory campaign the phase (`--phase`, 0
+//! exhalation .. 1 inspiration; 0 when not given); outputs are the maximum principal stress of
+//! each ROI element in pascals. The `--png` picture draws the liver at the view's phase.
 //!
 //! - One-shot: prints the ROI stress vector (one `element_id stress_Pa` line per ROI element,
 //!   after a header), the GP's predictive standard deviation when the model is a GP, what about
@@ -12,7 +14,8 @@
 //!   beside the model, the fingers, a title with x, y and the force, and a fixed colour scale
 //!   over the training stress range (the live view's, `palpa serve`).
 //! - `--stdin`, for a live device loop: reads one JSON object per line,
-//!   `{"x": 0.04, "y": 0.05, "force": 20.0}` (an optional `"id"` of any JSON type is echoed back),
+//!   `{"x": 0.04, "y": 0.05, "force": 20.0}` (an optional `"phase"`, and an optional `"id"` of
+//!   any JSON type echoed back),
 //!   and writes one JSON line per input line, flushed at once:
 //!   `{"line": 1, "stress": [...], "variance": null}` (`variance` [Pa^2] for a GP: the latent
 //!   variance shared by its raw outputs, on the tensor target by every stress component). A line that
@@ -117,14 +120,18 @@ fn non_finite_output(stress: &[f64], variance: Option<f64>) -> Result<(), String
     }
 }
 
-/// Set a model's respiratory phase; a phase given to a model without a phase input is refused,
-/// naming the model.
+/// Set a model's respiratory phase (0, the paper's frame, when not given: a `--stdin` line
+/// without `"phase"` does not inherit the line before's); a phase given to a model without a
+/// phase input is refused, naming the model.
 fn apply_phase(
     p: &mut surrogate::Predictor,
     phase: Option<f64>,
     model: &Path,
 ) -> Result<(), String> {
-    let Some(v) = phase else { return Ok(()) };
+    let Some(v) = phase else {
+        p.set_phase(0.0);
+        return Ok(());
+    };
     let v = check_phase(v)?;
     if !p.takes_phase() {
         return Err(format!(

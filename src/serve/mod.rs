@@ -138,13 +138,19 @@ impl Shared {
                 if self.deviation.is_none() {
                     return Err("this model (an MLP) gives no predictive deviation".into());
                 }
-                let force = force.unwrap_or_else(|| self.lock().force());
+                let (f, phase) = {
+                    let s = self.lock();
+                    (s.force(), s.phase_value())
+                };
+                let force = force.unwrap_or(f);
                 let me = self.clone();
                 tokio::task::spawn_blocking(move || {
                     let Some(d) = &me.deviation else {
                         return String::new();
                     };
                     let mut p = d.lock().unwrap_or_else(|p| p.into_inner());
+                    // the screen's phase, for a model that takes one
+                    p.set_phase(phase);
                     let (lo, hi) = me.extent;
                     session::deviation_map(&mut p, lo, hi, force, 48)
                 })

@@ -4,7 +4,7 @@
 //!
 //! ```json
 //! {"type": "frame", "seq": 12, "source": "plate", "x": -0.0725, "y": 0.1775, "force": 30.0,
-//!  "lifted": false, "phase": 0.0, "plate": [0.01, -0.02], "stress": [Pa, ...],
+//!  "lifted": false, "phase": 0.0, "liver_shift": 0.0, "plate": [0.01, -0.02], "stress": [Pa, ...],
 //!  "sd": 41.4, "max": {"index": 17, "value": 5241.3},
 //!  "warnings": [{"code": "force_above_training", "text": "..."}],
 //!  "stamp": 1732530000123.4, "received": 1732530000123.9, "predict_us": 21.0}
@@ -167,6 +167,11 @@ impl Session {
         }
     }
 
+    /// The current respiratory phase.
+    pub fn phase_value(&self) -> f64 {
+        self.phase
+    }
+
     /// The frame of the current state (for a screen that has just connected).
     pub fn current(&mut self) -> String {
         self.frame(None)
@@ -245,6 +250,7 @@ pub fn deviation_map(
     json!({
         "type": "deviation_map",
         "force": force,
+        "phase": predictor.phase(),
         "grid": {"x0": lo[0], "y0": lo[1], "dx": dx, "dy": dy, "nx": n, "ny": n},
         "sd": sd,
         "prior": predictor.prior_deviation(),

@@ -5,7 +5,7 @@
 //!
 //! | array | shape | dtype | meaning |
 //! |---|---|---|---|
-//! | `X` | n x c, c >= 3 | f64 | finger x [m], y [m], contact force [N]; optional further columns (e.g. time [s], depth [m]) named in the manifest |
+//! | `X` | n x c, c >= 3 | f64 | finger x [m], y [m], contact force [N]; optional further columns (e.g. time [s], depth [m], the respiratory phase) named in the manifest; a `phase` column is a model input ([`MODEL_INPUTS`]) |
 //! | `Y` | n x R | f64 | maximum principal Cauchy stress of each ROI element [Pa] |
 //! | `S` (optional) | n x R x 6 | f64 | full Cauchy stress per ROI element [Pa], Voigt order xx, yy, zz, xy, yz, zx |
 //! | `roi_ids` | R | int64 | element ids of the ROI |

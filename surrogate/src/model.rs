@@ -14,8 +14,9 @@
 //!
 //! The safetensors header's `__metadata__` says what the file is without the JSON beside it
 //! (all values strings, lists as JSON): `format` (`palpa-surrogate`), `version`, `kind` (`mlp`
-//! or `gp`), `target` (`principal` or `tensor`), `input_columns` (`["x","y","force"]`),
-//! `input_units` (`["m","m","N"]`), `output` (what the served values are) and `output_unit`
+//! or `gp`), `target` (`principal` or `tensor`), `input_columns` (`["x","y","force"]`, or
+//! with `"phase"` appended for a model trained on a respiratory campaign), `input_units`
+//! (`["m","m","N"]`, `"1"` for the phase), `output` (what the served values are) and `output_unit`
 //! (`Pa`). `python/palpa_surrogate.py` reads both files with numpy alone.
 //!
 //! M is the number of raw outputs: R for the principal-stress target, 6R for the tensor target
@@ -41,15 +42,17 @@ use std::path::{Path, PathBuf};
 
 /// Value of [`ModelMeta::format`].
 pub const MODEL_FORMAT: &str = "palpa-surrogate";
-/// Current value of [`ModelMeta::version`].
-pub const MODEL_VERSION: u32 = 2;
+/// Newest value of [`ModelMeta::version`]: 3, a model whose fourth input is the respiratory
+/// phase. A model of x, y and force is still written as version 2, the format that older
+/// readers take; they refuse a version-3 file instead of feeding it three inputs.
+pub const MODEL_VERSION: u32 = 3;
 
 /// Metadata sidecar of a saved model.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct ModelMeta {
     /// Always `"palpa-surrogate"`.
     pub format: String,
-    /// Format version, currently 2.
+    /// Format version: 2, or 3 for a model with the phase input ([`MODEL_VERSION`]).
     pub version: u32,
     /// Model family.
     pub kind: ModelKind,
@@ -266,7 +269,7 @@ impl TrainedModel {
         };
         let meta = ModelMeta {
             format: MODEL_FORMAT.into(),
-            version: MODEL_VERSION,
+            version: if inputs.len() > 3 { 3 } else { 2 },
             kind: self.kind(),
             input_columns: inputs.iter().map(|c| c.to_string()).collect(),
             roi_ids: roi_ids.to_vec(),
@@ -280,7 +283,10 @@ impl TrainedModel {
         };
         let metadata = [
             ("format", MODEL_FORMAT.to_string()),
-            ("version", MODEL_VERSION.to_string()),
+            (
+                "version",
+                (if inputs.len() > 3 { 3 } else { 2 }).to_string(),
+            ),
             ("kind", self.kind().to_string()),
             ("target", report.target.to_string()),
             (
@@ -353,6 +359,18 @@ impl Predictor {
                 format!(
                     "format {:?} version {}, expected {MODEL_FORMAT:?} version <= {MODEL_VERSION}",
                     meta.format, meta.version
+                ),
+            ));
+        }
+        let inputs = &crate::dataset::MODEL_INPUTS;
+        if meta.input_columns != inputs[..3] && meta.input_columns != inputs[..4] {
+            return Err(Error::format(
+                &js,
+                format!(
+                    "input_columns {:?}: a model takes {:?} or {:?}",
+                    meta.input_columns,
+                    &inputs[..3],
+                    &inputs[..4]
                 ),
             ));
         }

@@ -298,6 +298,17 @@ fn version_1_gp_files_load_and_a_bad_output_basis_is_an_error() {
     assert_eq!(header["input_columns"], r#"["x","y","force"]"#);
     assert_eq!(header["input_units"], r#"["m","m","N"]"#);
     assert_eq!(header["output_unit"], "Pa");
+    // input columns other than x, y, force (and phase) are an error naming them
+    let json = path.with_extension("json");
+    let good = std::fs::read_to_string(&json).unwrap();
+    let bad = good.replacen("\"force\"", "\"time\"", 1);
+    std::fs::write(&json, &bad).unwrap();
+    let err = Predictor::load(&path).unwrap_err().to_string();
+    assert!(
+        err.contains("input_columns") && err.contains("time"),
+        "{err}"
+    );
+    std::fs::write(&json, &good).unwrap();
     // a header that contradicts the JSON is an error naming the file
     let set = read_tensors(&path).unwrap();
     let mut wrong = header.clone();

@@ -139,14 +139,21 @@ const palpa = (() => {
     ctx.clearRect(0, 0, canvas.width, canvas.height);
     ctx.setTransform(dpr, 0, 0, dpr, 0, 0);
     const pal = scene.palette;
-    if (devImage && el("deviation").checked) drawDeviation();
-    // the liver and its ROI move caudally (down the page) with the respiratory phase
-    ctx.save();
-    ctx.translate(0, frame && frame.liver_shift ? frame.liver_shift * tf.s : 0);
+    // the liver and its ROI move caudally (down the page) with the respiratory phase; the
+    // moved liver is translucent, so the ribs of the still background show through, and lies
+    // under the deviation overlay
+    const shift = frame && frame.liver_shift ? frame.liver_shift * tf.s : 0;
     if (scene.model.takes_phase) {
+      ctx.save();
+      ctx.translate(0, shift);
+      ctx.globalAlpha = 0.6;
       ctx.fillStyle = rgb(pal.liver_fill);
       paths.liver.forEach((l) => ctx.fill(l));
+      ctx.restore();
     }
+    if (devImage && el("deviation").checked) drawDeviation();
+    ctx.save();
+    ctx.translate(0, shift);
     if (frame) {
       // cells by rising stress: where elements overlap in plan, the largest shows
       const s = frame.stress;
