@@ -312,7 +312,7 @@ fn default_voxel_phantoms_match_the_documented_counts() {
 /// The paper-like voxel (3 mm) as well, and the same anatomy at both voxels: the liver's and
 /// the whole body's volume agree within 1 % (the reduced box's faces round to the voxel, 3 %).
 /// Slow (the full 3 mm phantom has 611,800 hexahedra); run with
-/// `cargo test --release -p solver phantom_report -- --ignored --nocapture`.
+/// `cargo test --release -p phantom phantom_report -- --ignored --nocapture`.
 #[test]
 #[ignore]
 fn phantom_report() {
