@@ -604,20 +604,7 @@ fn phase_model_takes_the_phase(tmp: &Path, breath: &Path, plain: &Path, d: &Data
     assert!(String::from_utf8_lossy(&o.stderr).contains("phase = 1.5 is outside 0"));
     // --stdin: a line without "phase" is at phase 0, not the line before's
     let stream = |m: &Path, lines: &str| -> Vec<serde_json::Value> {
-        let mut child = Command::new(env!("CARGO_BIN_EXE_palpa"))
-            .args(["predict", s(m), "--stdin"])
-            .stdin(Stdio::piped())
-            .stdout(Stdio::piped())
-            .spawn()
-            .unwrap();
-        use std::io::Write as _;
-        child
-            .stdin
-            .take()
-            .unwrap()
-            .write_all(lines.as_bytes())
-            .unwrap();
-        let out = child.wait_with_output().unwrap();
+        let out = cli::predict_stdin(m, lines.as_bytes());
         String::from_utf8_lossy(&out.stdout)
             .lines()
             .map(|l| serde_json::from_str(l).unwrap())

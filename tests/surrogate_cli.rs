@@ -8,6 +8,8 @@
 use std::io::Write;
 use std::path::Path;
 use std::process::{Command, Output, Stdio};
+#[path = "support/cli.rs"]
+mod cli;
 
 /// ROI elements of the synthetic dataset.
 const R: usize = 8;
@@ -119,24 +121,12 @@ fn train_predict_and_stream() {
 
     // streaming: two good lines and a malformed one in the middle
     for model in [&mlp, &gp] {
-        let mut child = Command::new(env!("CARGO_BIN_EXE_palpa"))
-            .args(["predict", model.to_str().unwrap(), "--stdin"])
-            .stdin(Stdio::piped())
-            .stdout(Stdio::piped())
-            .stderr(Stdio::piped())
-            .spawn()
-            .unwrap();
-        child
-            .stdin
-            .take()
-            .unwrap()
-            .write_all(
-                b"{\"x\": 0.04, \"y\": 0.05, \"force\": 20, \"id\": 7}\n\
+        let o = cli::predict_stdin(
+            model,
+            b"{\"x\": 0.04, \"y\": 0.05, \"force\": 20, \"id\": 7}\n\
                   {\"x\": 0.04, \"y\": oops}\n\
                   {\"x\": 0.06, \"y\": 0.03, \"force\": 37.0}\n",
-            )
-            .unwrap();
-        let o = child.wait_with_output().unwrap();
+        );
         let stdout = text(&o.stdout);
         assert!(o.status.success(), "{}\n{stdout}", text(&o.stderr));
         let lines: Vec<serde_json::Value> = stdout

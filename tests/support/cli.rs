@@ -30,6 +30,21 @@ pub fn ok(args: &[&str]) -> String {
     stdout
 }
 
+/// Run `palpa predict MODEL --stdin` with `lines` on its stdin; its output.
+pub fn predict_stdin(model: &Path, lines: &[u8]) -> Output {
+    use std::io::Write as _;
+    use std::process::Stdio;
+    let mut child = Command::new(env!("CARGO_BIN_EXE_palpa"))
+        .args(["predict", s(model), "--stdin"])
+        .stdin(Stdio::piped())
+        .stdout(Stdio::piped())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap();
+    child.stdin.take().unwrap().write_all(lines).unwrap();
+    child.wait_with_output().unwrap()
+}
+
 /// A path as a command-line argument.
 pub fn s(p: &Path) -> &str {
     p.to_str().unwrap()
