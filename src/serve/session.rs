@@ -63,7 +63,6 @@ pub struct Session {
     y: f64,
     force: f64,
     lifted: bool,
-    phase: f64,
     plate: Option<[f64; 2]>,
     source: Source,
     seq: u64,
@@ -81,7 +80,6 @@ impl Session {
             y: home[1],
             force: 0.0,
             lifted: true,
-            phase: 0.0,
             plate: None,
             source: Source::Pointer,
             seq: 0,
@@ -151,7 +149,6 @@ impl Session {
     /// The respiratory phase (0 exhalation .. 1 inspiration): a model trained on a respiratory
     /// campaign predicts at it; one that takes x, y and force only ignores it.
     pub fn phase(&mut self, value: f64) -> String {
-        self.phase = value;
         self.model.predictor.set_phase(value);
         self.frame(None)
     }
@@ -161,15 +158,15 @@ impl Session {
     fn liver_shift(&self) -> f64 {
         match &self.model.view {
             Some(v) if self.model.predictor.takes_phase() => {
-                (self.phase - v.respiratory_phase) * v.max_liver_shift_m
+                (self.phase_value() - v.respiratory_phase) * v.max_liver_shift_m
             }
             _ => 0.0,
         }
     }
 
-    /// The current respiratory phase.
+    /// The current respiratory phase (held by the model's predictor).
     pub fn phase_value(&self) -> f64 {
-        self.phase
+        self.model.predictor.phase()
     }
 
     /// The frame of the current state (for a screen that has just connected).
@@ -211,7 +208,7 @@ impl Session {
             "y": self.y,
             "force": force,
             "lifted": self.lifted,
-            "phase": self.phase,
+            "phase": self.phase_value(),
             "liver_shift": self.liver_shift(),
             "plate": self.plate,
             "stress": stress,

@@ -184,6 +184,8 @@ impl TrainedModel {
     ) -> Result<()> {
         let (st, js) = model_paths(path.as_ref());
         let inputs = &crate::dataset::MODEL_INPUTS[..self.n_inputs().min(4)];
+        // version 3 only where it is needed: a model with the phase input (MODEL_VERSION)
+        let version = if inputs.len() > 3 { 3 } else { 2 };
         if let Some(dir) = st.parent().filter(|d| !d.as_os_str().is_empty()) {
             std::fs::create_dir_all(dir).map_err(|e| Error::io(dir, e))?;
         }
@@ -269,7 +271,7 @@ impl TrainedModel {
         };
         let meta = ModelMeta {
             format: MODEL_FORMAT.into(),
-            version: if inputs.len() > 3 { 3 } else { 2 },
+            version,
             kind: self.kind(),
             input_columns: inputs.iter().map(|c| c.to_string()).collect(),
             roi_ids: roi_ids.to_vec(),
@@ -283,10 +285,7 @@ impl TrainedModel {
         };
         let metadata = [
             ("format", MODEL_FORMAT.to_string()),
-            (
-                "version",
-                (if inputs.len() > 3 { 3 } else { 2 }).to_string(),
-            ),
+            ("version", version.to_string()),
             ("kind", self.kind().to_string()),
             ("target", report.target.to_string()),
             (
