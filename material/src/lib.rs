@@ -17,6 +17,7 @@ pub mod plasticity;
 pub mod principal;
 pub mod quantity;
 pub mod real;
+pub mod real_avx512;
 pub mod real_f32;
 pub mod spec;
 pub mod tensor;

@@ -271,8 +271,11 @@ macro_rules! arr {
 /// Eight `f64` lanes: the `wide` crate's `f64x8` (one AVX-512 register, or two AVX2 registers
 /// on the build's x86-64-v3 baseline, or four SSE2/NEON ones), which guarantees vector
 /// instructions where plain `[f64; 8]` loops were vectorised only in part.
+///
+/// Aligned to 64 bytes (one cache line, and the alignment of an AVX-512 register), so that the
+/// solver may read its stored lanes as [`crate::real_avx512::Z64x8`].
 #[derive(Clone, Copy, Debug, PartialEq)]
-#[repr(transparent)]
+#[repr(C, align(64))]
 pub struct F64x8(pub f64x8);
 
 /// Eight boolean lanes (all bits set where true), as `wide` compares give them.

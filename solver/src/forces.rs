@@ -30,6 +30,8 @@ use crate::element::precision::{NarrowRef, Precision, Refs};
 use crate::element::{fault_error, full, one_point, ElementOut, Formulation, Nodal, StepInput};
 use crate::model::{ChunkOut, ElementTotals, Group, Part, CHUNK};
 use material::real::{F64x8, Mask, Real, LANES};
+#[cfg(target_arch = "x86_64")]
+use material::real_avx512::Z64x8;
 use material::real_f32::F32x8;
 use material::{with_law, Law};
 use rayon::prelude::*;
@@ -191,12 +193,13 @@ fn run_chunk<L: Law>(l: &L, b: &Batch, ci: usize) -> ChunkOut {
     }
 }
 
-/// One chunk of batches with kernels over `R`, with the instruction set of [`simd_level`].
+/// One chunk of batches with kernels over `R` (over `R::Avx512` with AVX-512), with the
+/// instruction set of [`simd_level`].
 fn run_chunk_in<L: Law, R: KernelLanes>(l: &L, b: &Batch, ci: usize) -> ChunkOut {
     #[cfg(target_arch = "x86_64")]
     if simd_level() == "avx512" {
         // SAFETY: the processor has the features (checked by `simd_level`).
-        return unsafe { run_chunk_avx512::<L, R>(l, b, ci) };
+        return unsafe { run_chunk_avx512::<L, R::Avx512>(l, b, ci) };
     }
     run_chunk_body::<L, ScalarGather, R>(l, b, ci)
 }
@@ -208,16 +211,27 @@ unsafe fn run_chunk_avx512<L: Law, R: KernelLanes>(l: &L, b: &Batch, ci: usize) 
     run_chunk_body::<L, Avx512Gather, R>(l, b, ci)
 }
 
-/// The number types the element kernels run in ([`F64x8`], [`F32x8`]), and where each finds
-/// its reference data: the group's own (`f64`) or its [`NarrowRef`] (`f32`).
-trait KernelLanes: Real<Wide = F64x8> {
+/// The number types the element kernels run in ([`F64x8`], [`F32x8`], and [`Z64x8`] in place
+/// of `F64x8` with AVX-512), and where each finds its reference data and history: the group's
+/// own `f64` lanes (read as `Z64x8` by the AVX-512 kernels) or its [`NarrowRef`] (`f32`).
+trait KernelLanes: Real {
+    /// The type the AVX-512 kernels use instead (the same numbers, bitwise).
+    type Avx512: KernelLanes;
     fn refs(g: &Group) -> Refs<'_, Self>;
     /// A batch's nodal field in the kernel's number type: as it is in `f64`; relative to each
     /// element's first node before rounding in `f32` (see [`crate::element::precision`]).
     fn nodal(x: &Nodal<F64x8>) -> Nodal<Self>;
+    /// `f64` lanes in the law's number type.
+    fn wide(x: F64x8) -> Self::Wide;
+    /// A batch's stored history in the law's number type.
+    fn history(h: &mut [F64x8]) -> &mut [Self::Wide];
 }
 
 impl KernelLanes for F64x8 {
+    #[cfg(target_arch = "x86_64")]
+    type Avx512 = Z64x8;
+    #[cfg(not(target_arch = "x86_64"))]
+    type Avx512 = F64x8;
     #[inline(always)]
     fn refs(g: &Group) -> Refs<'_, Self> {
         g.refs()
@@ -226,9 +240,42 @@ impl KernelLanes for F64x8 {
     fn nodal(x: &Nodal<F64x8>) -> Nodal<Self> {
         *x
     }
+    #[inline(always)]
+    fn wide(x: F64x8) -> F64x8 {
+        x
+    }
+    #[inline(always)]
+    fn history(h: &mut [F64x8]) -> &mut [F64x8] {
+        h
+    }
+}
+
+#[cfg(target_arch = "x86_64")]
+impl KernelLanes for Z64x8 {
+    type Avx512 = Z64x8;
+    #[inline(always)]
+    fn refs(g: &Group) -> Refs<'_, Self> {
+        g.refs().as_z64x8()
+    }
+    #[inline(always)]
+    fn nodal(x: &Nodal<F64x8>) -> Nodal<Self> {
+        material::arr![3, |i| material::arr![8, |a| Z64x8::from_f64x8(x[i][a])]]
+    }
+    #[inline(always)]
+    fn wide(x: F64x8) -> Z64x8 {
+        Z64x8::from_f64x8(x)
+    }
+    #[inline(always)]
+    fn history(h: &mut [F64x8]) -> &mut [Z64x8] {
+        const { assert!(std::mem::size_of::<F64x8>() == std::mem::size_of::<Z64x8>()) };
+        const { assert!(std::mem::align_of::<F64x8>() >= std::mem::align_of::<Z64x8>()) };
+        // SAFETY: same size, no stricter alignment (checked above), any bits are valid lanes.
+        unsafe { std::slice::from_raw_parts_mut(h.as_mut_ptr() as *mut Z64x8, h.len()) }
+    }
 }
 
 impl KernelLanes for F32x8 {
+    type Avx512 = F32x8;
     #[inline(always)]
     fn refs(g: &Group) -> Refs<'_, Self> {
         g.narrow
@@ -242,6 +289,14 @@ impl KernelLanes for F32x8 {
             let x0 = x[i][0];
             material::arr![8, |a| F32x8::narrow(x[i][a] - x0)]
         }]
+    }
+    #[inline(always)]
+    fn wide(x: F64x8) -> F64x8 {
+        x
+    }
+    #[inline(always)]
+    fn history(h: &mut [F64x8]) -> &mut [F64x8] {
+        h
     }
 }
 
@@ -300,16 +355,16 @@ fn batch_forces<L: Law, G: GatherLanes, R: KernelLanes>(
     let xr = G::lanes(b.x_ref, conn);
     let xe: Nodal<F64x8> = material::arr![3, |i| material::arr![8, |a| xr[i][a] + ue[i][a]]];
     let (ue, ve, xe) = (R::nodal(&ue), R::nodal(&ve), R::nodal(&xe));
-    let s = R::narrow(density_scale);
+    let s = R::narrow(R::wide(density_scale));
     // SAFETY: batch bi owns history[bi*stride..(bi+1)*stride] alone.
-    let h = unsafe { b.hist.slice(bi * stride, stride) };
+    let h = R::history(unsafe { b.hist.slice(bi * stride, stride) });
     match b.form {
         Formulation::OnePoint(hg) => {
             let rf = one_point::OnePointRef {
                 grad: &refs.grad[bi],
                 gamma: &refs.gamma[bi],
-                vol0: R::narrow(lanes_of(&g.vol0, le0)),
-                hg_scale: R::narrow(lanes_of(&g.hg_scale, le0)),
+                vol0: R::narrow(R::wide(lanes_of(&g.vol0, le0))),
+                hg_scale: R::narrow(R::wide(lanes_of(&g.hg_scale, le0))),
                 physical: (!g.hg_frame.is_empty()).then(|| PhysicalRef {
                     frame: &refs.hg_frame[bi],
                     inv_len: &refs.hg_inv_len[bi],
@@ -325,7 +380,7 @@ fn batch_forces<L: Law, G: GatherLanes, R: KernelLanes>(
                 centre_grad: &refs.grad[bi],
                 gp_grad: &refs.gp_grad[bi],
                 gp_weight: &refs.gp_weight[bi],
-                vol0: R::narrow(lanes_of(&g.vol0, le0)),
+                vol0: R::narrow(R::wide(lanes_of(&g.vol0, le0))),
             };
             full::compute_forces(l, &rf, fbar, &xe, &ue, &ve, s, b.input, h, fe)
         }

@@ -20,6 +20,8 @@
 
 use super::Nodal;
 use material::real::{F64x8, Real};
+#[cfg(target_arch = "x86_64")]
+use material::real_avx512::Z64x8;
 use material::real_f32::F32x8;
 
 /// The number type of the element kernels.
@@ -84,6 +86,36 @@ impl<R> Refs<'_, R> {
             + std::mem::size_of_val(self.gp_grad)
             + std::mem::size_of_val(self.gp_weight)
     }
+}
+
+impl<'a> Refs<'a, F64x8> {
+    /// The same data read as [`Z64x8`] lanes, for the AVX-512 kernels (no copy: [`F64x8`] is
+    /// aligned to 64 bytes, as `Z64x8` needs, and both are eight `f64`).
+    #[cfg(target_arch = "x86_64")]
+    pub fn as_z64x8(&self) -> Refs<'a, Z64x8> {
+        Refs {
+            grad: recast(self.grad),
+            gamma: recast(self.gamma),
+            hg_frame: recast(self.hg_frame),
+            hg_inv_len: recast(self.hg_inv_len),
+            gp_grad: recast(self.gp_grad),
+            gp_weight: recast(self.gp_weight),
+        }
+    }
+}
+
+/// A slice of arrays of [`F64x8`] as the same arrays of [`Z64x8`] (only [`Refs::as_z64x8`] calls
+/// it, with those types).
+#[cfg(target_arch = "x86_64")]
+fn recast<A, B>(x: &[A]) -> &[B] {
+    const { assert!(std::mem::size_of::<F64x8>() == std::mem::size_of::<Z64x8>()) };
+    const { assert!(std::mem::align_of::<F64x8>() >= std::mem::align_of::<Z64x8>()) };
+    assert!(
+        std::mem::size_of::<A>() == std::mem::size_of::<B>()
+            && std::mem::align_of::<A>() >= std::mem::align_of::<B>()
+    );
+    // SAFETY: same size and no stricter alignment (checked); every bit pattern is a valid f64.
+    unsafe { std::slice::from_raw_parts(x.as_ptr() as *const B, x.len()) }
 }
 
 /// A group's reference data in `f32` lanes, built from the `f64` data the first time an `f32`

@@ -1,0 +1,377 @@
+//! Eight `f64` lanes in one AVX-512 register: [`Z64x8`], the number type of the solver's `f64`
+//! element kernels when the processor has AVX-512 (the solver's `forces::simd_level`).
+//!
+//! [`F64x8`] wraps the `wide` crate's `f64x8`, whose representation is fixed when `wide` is
+//! compiled: two AVX2 registers on the project's x86-64-v3 baseline. The solver compiles its
+//! batch kernel a second time for AVX-512 and picks it at run time, but LLVM does not fuse the
+//! pairs of 256-bit operations that `wide` emits into 512-bit ones, so that kernel still ran on
+//! half-width vectors. [`Z64x8`] holds an `__m512d` and calls the AVX-512 intrinsics directly.
+//! Its methods are `#[inline(always)]` and are meant to be reached only from code compiled with
+//! AVX-512 enabled (`#[target_feature(enable = "avx512f,...")]`): inlined there, each operator
+//! becomes one 512-bit instruction. Measured on this project's 2-core AMD EPYC (Zen 5, full-width
+//! AVX-512): `palpa bench`'s `f64` press case runs 1.25-1.35x faster than with [`F64x8`]
+//! (docs/performance.md). Constructing or using a [`Z64x8`] on a processor without AVX-512 is
+//! undefined behaviour, which is why only the solver's AVX-512 dispatch path names it.
+//!
+//! Every operation is the IEEE operation [`F64x8`] performs, in the same order, with the same
+//! comparison predicates and the same `max`/`min` operand order (`wide`'s `max`: `rhs` if it is
+//! NaN, else `vmaxpd(self, rhs)`). So the two types give bitwise the same results, and a run's
+//! numbers do not depend on the processor it ran on; `tests` below and the solver's
+//! determinism tests check it. The transcendentals (`exp`, `ln`, `ln_1p`, `cbrt`, `exp_m1`) go
+//! through [`F64x8`]'s (a lane-for-lane copy into two 256-bit halves and back), which keeps them
+//! bitwise equal by construction.
+
+#![cfg(target_arch = "x86_64")]
+
+use crate::real::{F64x8, Mask, Real, LANES};
+use std::arch::x86_64::*;
+use std::ops::{
+    Add, AddAssign, BitAnd, BitOr, Div, DivAssign, Mul, MulAssign, Neg, Not, Sub, SubAssign,
+};
+
+/// Eight `f64` lanes in one AVX-512 register (see the module doc for where it may be used).
+#[derive(Clone, Copy)]
+#[repr(transparent)]
+pub struct Z64x8(pub __m512d);
+
+/// Eight boolean lanes of [`Z64x8`]: an AVX-512 mask register, bit `i` for lane `i`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[repr(transparent)]
+pub struct ZM8(pub __mmask8);
+
+impl std::fmt::Debug for Z64x8 {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "Z64x8({:?})", self.to_array())
+    }
+}
+
+impl Z64x8 {
+    /// From an array of lanes.
+    #[inline(always)]
+    pub fn new(x: [f64; LANES]) -> Z64x8 {
+        // SAFETY: AVX-512 code only (module doc); the load is unaligned.
+        Z64x8(unsafe { _mm512_loadu_pd(x.as_ptr()) })
+    }
+    /// The lanes as an array.
+    #[inline(always)]
+    pub fn to_array(self) -> [f64; LANES] {
+        // SAFETY: `__m512d` and `[f64; 8]` have the same size and any bits are valid.
+        unsafe { std::mem::transmute::<__m512d, [f64; LANES]>(self.0) }
+    }
+    /// The same lanes as an [`F64x8`] (a copy, no rounding).
+    #[inline(always)]
+    pub fn to_f64x8(self) -> F64x8 {
+        F64x8::new(self.to_array())
+    }
+    /// From an [`F64x8`] (a copy, no rounding).
+    #[inline(always)]
+    pub fn from_f64x8(x: F64x8) -> Z64x8 {
+        Z64x8::new(x.to_array())
+    }
+    #[inline(always)]
+    fn cmp<const P: i32>(self, o: Z64x8) -> ZM8 {
+        // SAFETY: AVX-512 code only.
+        ZM8(unsafe { _mm512_cmp_pd_mask::<P>(self.0, o.0) })
+    }
+    /// `wide`'s `f64x8::max`: `o` where it is NaN, else `vmaxpd(self, o)`.
+    #[inline(always)]
+    fn wide_max(self, o: Z64x8) -> Z64x8 {
+        // SAFETY: AVX-512 code only.
+        let m = Z64x8(unsafe { _mm512_max_pd(self.0, o.0) });
+        Z64x8::select(o.cmp::<_CMP_UNORD_Q>(o), self, m)
+    }
+    /// `wide`'s `f64x8::min`: `o` where it is NaN, else `vminpd(self, o)`.
+    #[inline(always)]
+    fn wide_min(self, o: Z64x8) -> Z64x8 {
+        // SAFETY: AVX-512 code only.
+        let m = Z64x8(unsafe { _mm512_min_pd(self.0, o.0) });
+        Z64x8::select(o.cmp::<_CMP_UNORD_Q>(o), self, m)
+    }
+    /// A function of [`F64x8`] applied lane for lane.
+    #[inline(always)]
+    fn through(self, f: impl Fn(F64x8) -> F64x8) -> Z64x8 {
+        Z64x8::from_f64x8(f(self.to_f64x8()))
+    }
+}
+
+impl BitAnd for ZM8 {
+    type Output = ZM8;
+    #[inline(always)]
+    fn bitand(self, o: ZM8) -> ZM8 {
+        ZM8(self.0 & o.0)
+    }
+}
+impl BitOr for ZM8 {
+    type Output = ZM8;
+    #[inline(always)]
+    fn bitor(self, o: ZM8) -> ZM8 {
+        ZM8(self.0 | o.0)
+    }
+}
+impl Not for ZM8 {
+    type Output = ZM8;
+    #[inline(always)]
+    fn not(self) -> ZM8 {
+        ZM8(!self.0)
+    }
+}
+impl Mask for ZM8 {
+    #[inline(always)]
+    fn splat(b: bool) -> Self {
+        ZM8(if b { 0xff } else { 0 })
+    }
+    #[inline(always)]
+    fn any(self) -> bool {
+        self.0 != 0
+    }
+    #[inline(always)]
+    fn lane(self, i: usize) -> bool {
+        self.0 >> i & 1 == 1
+    }
+}
+
+/// A binary operator of [`Z64x8`], with another [`Z64x8`] and with a plain `f64` (splat).
+macro_rules! z_binary {
+    ($tr:ident, $f:ident, $atr:ident, $af:ident, $op:tt, $intr:ident) => {
+        impl $tr for Z64x8 {
+            type Output = Z64x8;
+            #[inline(always)]
+            fn $f(self, o: Z64x8) -> Z64x8 {
+                // SAFETY: AVX-512 code only (module doc).
+                Z64x8(unsafe { $intr(self.0, o.0) })
+            }
+        }
+        impl $tr<f64> for Z64x8 {
+            type Output = Z64x8;
+            #[inline(always)]
+            fn $f(self, o: f64) -> Z64x8 {
+                self $op Z64x8::splat(o)
+            }
+        }
+        impl $atr for Z64x8 {
+            #[inline(always)]
+            fn $af(&mut self, o: Z64x8) {
+                *self = *self $op o;
+            }
+        }
+    };
+}
+z_binary!(Add, add, AddAssign, add_assign, +, _mm512_add_pd);
+z_binary!(Sub, sub, SubAssign, sub_assign, -, _mm512_sub_pd);
+z_binary!(Mul, mul, MulAssign, mul_assign, *, _mm512_mul_pd);
+z_binary!(Div, div, DivAssign, div_assign, /, _mm512_div_pd);
+
+impl Neg for Z64x8 {
+    type Output = Z64x8;
+    #[inline(always)]
+    fn neg(self) -> Z64x8 {
+        // As `wide`: the sign bit flipped (AVX512DQ).
+        // SAFETY: AVX-512 code only.
+        Z64x8(unsafe { _mm512_xor_pd(self.0, _mm512_set1_pd(-0.0)) })
+    }
+}
+
+impl Real for Z64x8 {
+    type Mask = ZM8;
+    const LANES: usize = LANES;
+    type Wide = Z64x8;
+    #[inline(always)]
+    fn widen(self) -> Z64x8 {
+        self
+    }
+    #[inline(always)]
+    fn narrow(w: Z64x8) -> Self {
+        w
+    }
+    #[inline(always)]
+    fn narrow_mask(m: ZM8) -> ZM8 {
+        m
+    }
+    #[inline(always)]
+    fn splat(x: f64) -> Self {
+        // SAFETY: AVX-512 code only.
+        Z64x8(unsafe { _mm512_set1_pd(x) })
+    }
+    #[inline(always)]
+    fn lane(self, i: usize) -> f64 {
+        self.to_array()[i]
+    }
+    #[inline(always)]
+    fn set_lane(&mut self, i: usize, x: f64) {
+        let mut a = self.to_array();
+        a[i] = x;
+        *self = Z64x8::new(a);
+    }
+    #[inline(always)]
+    fn from_slice(x: &[f64]) -> Self {
+        let x = &x[..LANES];
+        // SAFETY: eight values in bounds (checked above); AVX-512 code only.
+        Z64x8(unsafe { _mm512_loadu_pd(x.as_ptr()) })
+    }
+    #[inline(always)]
+    fn write_to(self, out: &mut [f64]) {
+        let out = &mut out[..LANES];
+        // SAFETY: eight values in bounds (checked above); AVX-512 code only.
+        unsafe { _mm512_storeu_pd(out.as_mut_ptr(), self.0) }
+    }
+    #[inline(always)]
+    fn sqrt(self) -> Self {
+        // SAFETY: AVX-512 code only.
+        Z64x8(unsafe { _mm512_sqrt_pd(self.0) })
+    }
+    #[inline(always)]
+    fn cbrt(self) -> Self {
+        self.through(|x| x.cbrt())
+    }
+    #[inline(always)]
+    fn exp(self) -> Self {
+        self.through(|x| x.exp())
+    }
+    #[inline(always)]
+    fn exp_m1(self) -> Self {
+        self.through(|x| x.exp_m1())
+    }
+    #[inline(always)]
+    fn ln(self) -> Self {
+        self.through(|x| x.ln())
+    }
+    #[inline(always)]
+    fn ln_1p(self) -> Self {
+        self.through(|x| x.ln_1p())
+    }
+    #[inline(always)]
+    fn abs(self) -> Self {
+        // SAFETY: AVX-512 code only (AVX512DQ, which the solver's dispatch checks).
+        Z64x8(unsafe { _mm512_andnot_pd(_mm512_set1_pd(-0.0), self.0) })
+    }
+    #[inline(always)]
+    fn max(self, o: Self) -> Self {
+        // As F64x8 (and f64::max): the other operand where one is NaN.
+        let m = self.wide_max(o);
+        Self::select(self.ne(self), o, Self::select(o.ne(o), self, m))
+    }
+    #[inline(always)]
+    fn min(self, o: Self) -> Self {
+        let m = self.wide_min(o);
+        Self::select(self.ne(self), o, Self::select(o.ne(o), self, m))
+    }
+    #[inline(always)]
+    fn lt(self, o: Self) -> ZM8 {
+        self.cmp::<_CMP_LT_OQ>(o)
+    }
+    #[inline(always)]
+    fn le(self, o: Self) -> ZM8 {
+        self.cmp::<_CMP_LE_OQ>(o)
+    }
+    #[inline(always)]
+    fn gt(self, o: Self) -> ZM8 {
+        self.cmp::<_CMP_GT_OQ>(o)
+    }
+    #[inline(always)]
+    fn ge(self, o: Self) -> ZM8 {
+        self.cmp::<_CMP_GE_OQ>(o)
+    }
+    #[inline(always)]
+    fn ne(self, o: Self) -> ZM8 {
+        self.cmp::<_CMP_NEQ_UQ>(o)
+    }
+    #[inline(always)]
+    fn is_finite(self) -> ZM8 {
+        self.abs().cmp::<_CMP_LT_OQ>(Z64x8::splat(f64::INFINITY))
+    }
+    #[inline(always)]
+    fn select(m: ZM8, a: Self, b: Self) -> Self {
+        // SAFETY: AVX-512 code only.
+        Z64x8(unsafe { _mm512_mask_blend_pd(m.0, b.0, a.0) })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Numbers that exercise every branch: signed zeros, NaN, infinities, subnormals, huge and
+    /// tiny values, ordinary ones.
+    fn samples() -> Vec<f64> {
+        let mut v = vec![
+            0.0,
+            -0.0,
+            f64::NAN,
+            f64::INFINITY,
+            -f64::INFINITY,
+            1e-310,
+            -1e-310,
+            1e300,
+            -1e300,
+            1.0,
+            -1.0,
+            0.5,
+            709.0,
+            -708.0,
+            800.0,
+        ];
+        let mut s = 0x2545_f491_4f6c_dd1du64;
+        for _ in 0..400 {
+            s ^= s << 13;
+            s ^= s >> 7;
+            s ^= s << 17;
+            let m = (s >> 11) as f64 / (1u64 << 53) as f64;
+            let e = ((s & 0x3f) as i32) - 32;
+            let sign = if s & 0x40 != 0 { -1.0 } else { 1.0 };
+            v.push(sign * m * 2f64.powi(e));
+        }
+        v
+    }
+
+    fn same(a: F64x8, b: Z64x8) -> bool {
+        a.to_array()
+            .iter()
+            .zip(b.to_array())
+            .all(|(x, y)| x.to_bits() == y.to_bits())
+    }
+
+    /// Every operation of [`Z64x8`] gives bitwise what [`F64x8`] gives, on the same lanes.
+    #[test]
+    fn z64x8_is_bitwise_f64x8() {
+        if !std::arch::is_x86_feature_detected!("avx512f")
+            || !std::arch::is_x86_feature_detected!("avx512dq")
+        {
+            eprintln!("no AVX-512 here: nothing to compare");
+            return;
+        }
+        let s = samples();
+        let n = s.len() - s.len() % 8;
+        for a0 in (0..n).step_by(8) {
+            for b0 in [0, 8, 16, 24, 40, a0] {
+                let (a, b) = (F64x8::from_slice(&s[a0..]), F64x8::from_slice(&s[b0..]));
+                let (za, zb) = (Z64x8::from_slice(&s[a0..]), Z64x8::from_slice(&s[b0..]));
+                assert!(same(a + b, za + zb));
+                assert!(same(a - b, za - zb));
+                assert!(same(a * b, za * zb));
+                assert!(same(a / b, za / zb));
+                assert!(same(a * 0.3, za * 0.3));
+                assert!(same(-a, -za));
+                assert!(same(a.max(b), za.max(zb)));
+                assert!(same(a.min(b), za.min(zb)));
+                assert!(same(a.abs(), za.abs()));
+                assert!(same(a.abs().sqrt(), za.abs().sqrt()));
+                assert!(same(a.exp(), za.exp()));
+                assert!(same(a.abs().ln(), za.abs().ln()));
+                assert!(same(a.ln_1p(), za.ln_1p()));
+                assert!(same(a.abs().cbrt(), za.abs().cbrt()));
+                for l in 0..LANES {
+                    assert_eq!(a.lt(b).lane(l), za.lt(zb).lane(l));
+                    assert_eq!(a.le(b).lane(l), za.le(zb).lane(l));
+                    assert_eq!(a.gt(b).lane(l), za.gt(zb).lane(l));
+                    assert_eq!(a.ge(b).lane(l), za.ge(zb).lane(l));
+                    assert_eq!(a.ne(b).lane(l), za.ne(zb).lane(l));
+                    assert_eq!(a.is_finite().lane(l), za.is_finite().lane(l));
+                }
+                let m = a.lt(b) | !a.is_finite();
+                let zm = za.lt(zb) | !za.is_finite();
+                assert!(same(F64x8::select(m, a, b), Z64x8::select(zm, za, zb)));
+                assert_eq!(m.any(), zm.any());
+            }
+        }
+    }
+}
