@@ -27,7 +27,8 @@
 //! bitwise; each law's test holds the two within a few ulp.
 
 use std::ops::{
-    Add, AddAssign, BitAnd, BitOr, Div, DivAssign, Mul, MulAssign, Neg, Not, Sub, SubAssign,
+    Add, AddAssign, BitAnd, BitOr, Div, DivAssign, Mul, MulAssign, Neg, Not, Shl, Shr, Sub,
+    SubAssign,
 };
 use wide::bytemuck::cast;
 use wide::{f64x8, u64x8};
@@ -499,11 +500,32 @@ impl Real for F64x8 {
     lane_real_methods!(F64x8, M8, f64x8, f64);
 }
 
-impl F64x8 {
-    #[inline(always)]
-    fn eq_(self, o: F64x8) -> M8 {
-        M8(self.0.simd_eq(o.0))
-    }
+/// The bit-level view of the lane types that the vector transcendentals ([`exp_lanes`],
+/// [`ln_lanes`], ...) are written over, so that [`F64x8`] and the AVX-512 lanes
+/// ([`crate::real_avx512::Z64x8`]) run the same operations on their own registers.
+pub trait LaneBits: Real {
+    /// Eight `u64` lanes.
+    type U: Copy
+        + Add<Output = Self::U>
+        + Sub<Output = Self::U>
+        + BitAnd<Output = Self::U>
+        + BitOr<Output = Self::U>
+        + Shl<u32, Output = Self::U>
+        + Shr<u32, Output = Self::U>;
+    /// The bits of each lane.
+    fn bits(self) -> Self::U;
+    /// Lanes from their bits.
+    fn from_bits(b: Self::U) -> Self;
+    /// The same `u64` in every lane.
+    fn splat_u(x: u64) -> Self::U;
+    /// `wide`'s `max(lo)` then `min(hi)`: `vmaxpd`/`vminpd` with the bound kept where it is NaN.
+    fn clamp_raw(self, lo: f64, hi: f64) -> Self;
+    /// Lane-wise `==` (ordered).
+    fn eq_(self, o: Self) -> Self::Mask;
+}
+
+impl LaneBits for F64x8 {
+    type U = u64x8;
     #[inline(always)]
     fn bits(self) -> u64x8 {
         cast(self.0)
@@ -511,6 +533,18 @@ impl F64x8 {
     #[inline(always)]
     fn from_bits(b: u64x8) -> F64x8 {
         F64x8(cast(b))
+    }
+    #[inline(always)]
+    fn splat_u(x: u64) -> u64x8 {
+        u64x8::splat(x)
+    }
+    #[inline(always)]
+    fn clamp_raw(self, lo: f64, hi: f64) -> F64x8 {
+        F64x8(self.0.max(f64x8::splat(lo)).min(f64x8::splat(hi)))
+    }
+    #[inline(always)]
+    fn eq_(self, o: F64x8) -> M8 {
+        M8(self.0.simd_eq(o.0))
     }
 }
 
@@ -521,35 +555,35 @@ const SHIFT: f64 = 6_755_399_441_055_744.0;
 
 /// `2^k` for integer-valued `kf` in [-1022, 1023] (`kf + SHIFT` holds k in its low bits).
 #[inline(always)]
-fn pow2(kf: F64x8) -> F64x8 {
-    let k = (kf + SHIFT).bits() - u64x8::splat(SHIFT.to_bits());
-    F64x8::from_bits((k + u64x8::splat(1023)) << 52)
+fn pow2<R: LaneBits>(kf: R) -> R {
+    let k = (kf + SHIFT).bits() - R::splat_u(SHIFT.to_bits());
+    R::from_bits((k + R::splat_u(1023)) << 52)
 }
 
 /// e^x in every lane with vector operations only: fdlibm's e_exp.c reduction `x = k ln2 + r`,
 /// `|r| <= ln2/2`, and its degree-5 minimax rational form (error < 1 ulp); +inf above 709.78,
 /// 0 below -708.39 (no subnormal results), NaN stays NaN.
 #[inline(always)]
-pub fn exp_lanes(x: F64x8) -> F64x8 {
+pub fn exp_lanes<R: LaneBits>(x: R) -> R {
     const P1: f64 = 1.666_666_666_666_660_190_37e-01;
     const P2: f64 = -2.777_777_777_701_559_338_42e-03;
     const P3: f64 = 6.613_756_321_437_934_361_17e-05;
     const P4: f64 = -1.653_390_220_546_525_153_90e-06;
     const P5: f64 = 4.138_136_797_057_238_460_39e-08;
-    let xc = F64x8(x.0.max(f64x8::splat(-708.39)).min(f64x8::splat(709.78)));
+    let xc = x.clamp_raw(-708.39, 709.78);
     let kf = (xc * std::f64::consts::LOG2_E + SHIFT) - SHIFT;
     let hi = xc - kf * LN2_HI;
     let lo = kf * LN2_LO;
     let r = hi - lo;
     let t = r * r;
     let c = r - t * ((((t * P5 + P4) * t + P3) * t + P2) * t + P1);
-    let y = F64x8::splat(1.0) - ((lo - (r * c) / (F64x8::splat(2.0) - c)) - hi);
+    let y = R::splat(1.0) - ((lo - (r * c) / (R::splat(2.0) - c)) - hi);
     // 2^k in two halves, so k up to 1024 stays representable.
     let k1 = (kf * 0.5 + SHIFT) - SHIFT;
     let v = y * pow2(k1) * pow2(kf - k1);
-    let v = F64x8::select(x.gt(F64x8::splat(709.78)), F64x8::splat(f64::INFINITY), v);
-    let v = F64x8::select(x.lt(F64x8::splat(-708.39)), F64x8::zero(), v);
-    F64x8::select(x.ne(x), x, v)
+    let v = R::select(x.gt(R::splat(709.78)), R::splat(f64::INFINITY), v);
+    let v = R::select(x.lt(R::splat(-708.39)), R::zero(), v);
+    R::select(x.ne(x), x, v)
 }
 
 /// ln x in every lane with vector operations only (fdlibm's e_log.c: `x = 2^k m`,
@@ -557,7 +591,7 @@ pub fn exp_lanes(x: F64x8) -> F64x8 {
 /// polynomial in `s`; error < 1 ulp). Zero gives -inf, negative numbers and NaN give NaN, +inf
 /// gives +inf; subnormal inputs are scaled by 2^54 first.
 #[inline(always)]
-pub fn ln_lanes(x: F64x8) -> F64x8 {
+pub fn ln_lanes<R: LaneBits>(x: R) -> R {
     const LG1: f64 = 6.666_666_666_666_735_130e-01;
     const LG2: f64 = 3.999_999_999_940_941_908e-01;
     const LG3: f64 = 2.857_142_874_366_239_149e-01;
@@ -565,19 +599,19 @@ pub fn ln_lanes(x: F64x8) -> F64x8 {
     const LG5: f64 = 1.818_357_216_161_805_012e-01;
     const LG6: f64 = 1.531_383_769_920_937_332e-01;
     const LG7: f64 = 1.479_819_860_511_658_591e-01;
-    let sub = x.lt(F64x8::splat(f64::MIN_POSITIVE));
-    let xs = F64x8::select(sub, x * 18_014_398_509_481_984.0, x); // 2^54
+    let sub = x.lt(R::splat(f64::MIN_POSITIVE));
+    let xs = R::select(sub, x * 18_014_398_509_481_984.0, x); // 2^54
     let bits = xs.bits();
     // Mantissa moved into [sqrt(2)/2, sqrt(2)): add (1 - sqrt(2)/2) to the high bits as fdlibm.
-    let hx = (bits >> 32) + u64x8::splat(0x3ff0_0000 - 0x3fe6_a09e);
-    let m = F64x8::from_bits(
-        (((hx & u64x8::splat(0x000f_ffff)) + u64x8::splat(0x3fe6_a09e)) << 32)
-            | (bits & u64x8::splat(0xffff_ffff)),
+    let hx = (bits >> 32) + R::splat_u(0x3ff0_0000 - 0x3fe6_a09e);
+    let m = R::from_bits(
+        (((hx & R::splat_u(0x000f_ffff)) + R::splat_u(0x3fe6_a09e)) << 32)
+            | (bits & R::splat_u(0xffff_ffff)),
     );
     // k as f64 through the shift trick (k - 0x3ff wraps as two's complement).
-    let kb = (hx >> 20) + u64x8::splat(SHIFT.to_bits().wrapping_sub(0x3ff));
-    let kf = F64x8::from_bits(kb) - SHIFT;
-    let kf = F64x8::select(sub, kf - 54.0, kf);
+    let kb = (hx >> 20) + R::splat_u(SHIFT.to_bits().wrapping_sub(0x3ff));
+    let kf = R::from_bits(kb) - SHIFT;
+    let kf = R::select(sub, kf - 54.0, kf);
     let f = m - 1.0;
     let hfsq = f * f * 0.5;
     let s = f / (f + 2.0);
@@ -587,27 +621,27 @@ pub fn ln_lanes(x: F64x8) -> F64x8 {
     let t2 = z * (((w * LG7 + LG5) * w + LG3) * w + LG1);
     let r = t2 + t1;
     let v = kf * LN2_HI - ((hfsq - (s * (hfsq + r) + kf * LN2_LO)) - f);
-    let v = F64x8::select(x.eq_(F64x8::zero()), F64x8::splat(f64::NEG_INFINITY), v);
-    let v = F64x8::select(!x.ge(F64x8::zero()), F64x8::splat(f64::NAN), v);
-    F64x8::select(x.eq_(F64x8::splat(f64::INFINITY)), x, v)
+    let v = R::select(x.eq_(R::zero()), R::splat(f64::NEG_INFINITY), v);
+    let v = R::select(!x.ge(R::zero()), R::splat(f64::NAN), v);
+    R::select(x.eq_(R::splat(f64::INFINITY)), x, v)
 }
 
 /// ln(1 + x) in every lane: `ln(u) x / (u - 1)` with `u = 1 + x` (exact `x` where `u == 1`),
 /// Goldberg's correction of the rounding in `1 + x`.
 #[inline(always)]
-pub fn ln_1p_lanes(x: F64x8) -> F64x8 {
+pub fn ln_1p_lanes<R: LaneBits>(x: R) -> R {
     let u = x + 1.0;
     let d = u - 1.0;
     let l = ln_lanes(u);
-    let same = d.eq_(F64x8::zero());
-    let v = l * (x / F64x8::select(same, F64x8::splat(1.0), d));
-    let v = F64x8::select(u.eq_(F64x8::splat(f64::INFINITY)), l, v);
-    F64x8::select(same, x, v)
+    let same = d.eq_(R::zero());
+    let v = l * (x / R::select(same, R::splat(1.0), d));
+    let v = R::select(u.eq_(R::splat(f64::INFINITY)), l, v);
+    R::select(same, x, v)
 }
 
 /// Cube root of positive lanes: `exp(ln(x)/3)` and one Newton step on `y^3 = x`.
 #[inline(always)]
-pub fn cbrt_lanes(x: F64x8) -> F64x8 {
+pub fn cbrt_lanes<R: LaneBits>(x: R) -> R {
     let y = exp_lanes(ln_lanes(x) * (1.0 / 3.0));
     y - (y - x / (y * y)) * (1.0 / 3.0)
 }

@@ -17,16 +17,19 @@
 //! comparison predicates and the same `max`/`min` operand order (`wide`'s `max`: `rhs` if it is
 //! NaN, else `vmaxpd(self, rhs)`). So the two types give bitwise the same results, and a run's
 //! numbers do not depend on the processor it ran on; `tests` below and the solver's
-//! determinism tests check it. The transcendentals (`exp`, `ln`, `ln_1p`, `cbrt`, `exp_m1`) go
-//! through [`F64x8`]'s (a lane-for-lane copy into two 256-bit halves and back), which keeps them
-//! bitwise equal by construction.
+//! `tests/simd_paths.rs` check it. The transcendentals are the same generic functions as
+//! [`F64x8`]'s ([`exp_lanes`], [`ln_lanes`], ...; [`LaneBits`] gives their bit operations on
+//! [`ZU64`]), except `exp_m1`, which goes through [`F64x8`]'s (it calls the library per lane).
 
 #![cfg(target_arch = "x86_64")]
 
-use crate::real::{F64x8, Mask, Real, LANES};
+use crate::real::{
+    cbrt_lanes, exp_lanes, ln_1p_lanes, ln_lanes, F64x8, LaneBits, Mask, Real, LANES,
+};
 use std::arch::x86_64::*;
 use std::ops::{
-    Add, AddAssign, BitAnd, BitOr, Div, DivAssign, Mul, MulAssign, Neg, Not, Sub, SubAssign,
+    Add, AddAssign, BitAnd, BitOr, Div, DivAssign, Mul, MulAssign, Neg, Not, Shl, Shr, Sub,
+    SubAssign,
 };
 
 /// Eight `f64` lanes in one AVX-512 register (see the module doc for where it may be used).
@@ -221,11 +224,11 @@ impl Real for Z64x8 {
     }
     #[inline(always)]
     fn cbrt(self) -> Self {
-        self.through(|x| x.cbrt())
+        cbrt_lanes(self)
     }
     #[inline(always)]
     fn exp(self) -> Self {
-        self.through(|x| x.exp())
+        exp_lanes(self)
     }
     #[inline(always)]
     fn exp_m1(self) -> Self {
@@ -233,11 +236,11 @@ impl Real for Z64x8 {
     }
     #[inline(always)]
     fn ln(self) -> Self {
-        self.through(|x| x.ln())
+        ln_lanes(self)
     }
     #[inline(always)]
     fn ln_1p(self) -> Self {
-        self.through(|x| x.ln_1p())
+        ln_1p_lanes(self)
     }
     #[inline(always)]
     fn abs(self) -> Self {
@@ -286,6 +289,73 @@ impl Real for Z64x8 {
     }
 }
 
+/// Eight `u64` lanes in one AVX-512 register: the bits of [`Z64x8`] for the transcendentals.
+#[derive(Clone, Copy)]
+#[repr(transparent)]
+pub struct ZU64(pub __m512i);
+
+/// A binary operator of [`ZU64`].
+macro_rules! zu_binary {
+    ($tr:ident, $f:ident, $intr:ident) => {
+        impl $tr for ZU64 {
+            type Output = ZU64;
+            #[inline(always)]
+            fn $f(self, o: ZU64) -> ZU64 {
+                // SAFETY: AVX-512 code only (module doc).
+                ZU64(unsafe { $intr(self.0, o.0) })
+            }
+        }
+    };
+}
+zu_binary!(Add, add, _mm512_add_epi64);
+zu_binary!(Sub, sub, _mm512_sub_epi64);
+zu_binary!(BitAnd, bitand, _mm512_and_si512);
+zu_binary!(BitOr, bitor, _mm512_or_si512);
+
+impl Shl<u32> for ZU64 {
+    type Output = ZU64;
+    #[inline(always)]
+    fn shl(self, n: u32) -> ZU64 {
+        // As `wide`: the count taken modulo 64. SAFETY: AVX-512 code only.
+        ZU64(unsafe { _mm512_sll_epi64(self.0, _mm_cvtsi64_si128((n & 63) as i64)) })
+    }
+}
+impl Shr<u32> for ZU64 {
+    type Output = ZU64;
+    #[inline(always)]
+    fn shr(self, n: u32) -> ZU64 {
+        // SAFETY: AVX-512 code only.
+        ZU64(unsafe { _mm512_srl_epi64(self.0, _mm_cvtsi64_si128((n & 63) as i64)) })
+    }
+}
+
+impl LaneBits for Z64x8 {
+    type U = ZU64;
+    #[inline(always)]
+    fn bits(self) -> ZU64 {
+        // SAFETY: AVX-512 code only.
+        ZU64(unsafe { _mm512_castpd_si512(self.0) })
+    }
+    #[inline(always)]
+    fn from_bits(b: ZU64) -> Z64x8 {
+        // SAFETY: AVX-512 code only.
+        Z64x8(unsafe { _mm512_castsi512_pd(b.0) })
+    }
+    #[inline(always)]
+    fn splat_u(x: u64) -> ZU64 {
+        // SAFETY: AVX-512 code only.
+        ZU64(unsafe { _mm512_set1_epi64(x as i64) })
+    }
+    #[inline(always)]
+    fn clamp_raw(self, lo: f64, hi: f64) -> Z64x8 {
+        self.wide_max(Z64x8::splat(lo)).wide_min(Z64x8::splat(hi))
+    }
+    #[inline(always)]
+    fn eq_(self, o: Z64x8) -> ZM8 {
+        self.cmp::<_CMP_EQ_OQ>(o)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -323,11 +393,13 @@ mod tests {
         v
     }
 
+    /// Bitwise equal lanes, NaN matching any NaN (LLVM does not keep a NaN's sign or payload:
+    /// it may commute the operands of a product whose two factors are NaN).
     fn same(a: F64x8, b: Z64x8) -> bool {
         a.to_array()
             .iter()
             .zip(b.to_array())
-            .all(|(x, y)| x.to_bits() == y.to_bits())
+            .all(|(x, y)| x.to_bits() == y.to_bits() || (x.is_nan() && y.is_nan()))
     }
 
     /// Every operation of [`Z64x8`] gives bitwise what [`F64x8`] gives, on the same lanes.
