@@ -17,7 +17,8 @@
 //! comparison predicates and the same `max`/`min` operand order (`wide`'s `max`: `rhs` if it is
 //! NaN, else `vmaxpd(self, rhs)`). So the two types give bitwise the same results, and a run's
 //! numbers do not depend on the processor it ran on; `tests` below and the solver's
-//! `tests/simd_paths.rs` check it. The transcendentals are the same generic functions as
+//! `tests/simd_paths.rs` check it. [`Z32x8`] is the same idea for the `f32` kernels: their
+//! lanes as [`F32x8`]'s, their laws in [`Z64x8`]. The transcendentals are the same generic functions as
 //! [`F64x8`]'s ([`exp_lanes`], [`ln_lanes`], ...; [`LaneBits`] gives their bit operations on
 //! [`ZU64`]), except `exp_m1`, which goes through [`F64x8`]'s (it calls the library per lane).
 
@@ -26,6 +27,7 @@
 use crate::real::{
     cbrt_lanes, exp_lanes, ln_1p_lanes, ln_lanes, F64x8, LaneBits, Mask, Real, LANES,
 };
+use crate::real_f32::{F32x8, M8f};
 use std::arch::x86_64::*;
 use std::ops::{
     Add, AddAssign, BitAnd, BitOr, Div, DivAssign, Mul, MulAssign, Neg, Not, Shl, Shr, Sub,
@@ -356,6 +358,167 @@ impl LaneBits for Z64x8 {
     }
 }
 
+/// The single-precision kernel lanes of the AVX-512 path: [`F32x8`]'s numbers and operations
+/// (one 256-bit register), with [`Z64x8`] as the law's number type instead of [`F64x8`], so the
+/// laws of an `f32` run also evaluate in 512-bit registers. Widening and narrowing are the
+/// same exact conversion and round-to-nearest as [`F32x8`]'s, so the two give bitwise the same
+/// results.
+#[derive(Clone, Copy, Debug)]
+#[repr(transparent)]
+pub struct Z32x8(pub F32x8);
+
+/// A binary operator of [`Z32x8`]: [`F32x8`]'s.
+macro_rules! z32_binary {
+    ($tr:ident, $f:ident, $atr:ident, $af:ident, $op:tt) => {
+        impl $tr for Z32x8 {
+            type Output = Z32x8;
+            #[inline(always)]
+            fn $f(self, o: Z32x8) -> Z32x8 {
+                Z32x8(self.0 $op o.0)
+            }
+        }
+        impl $tr<f64> for Z32x8 {
+            type Output = Z32x8;
+            #[inline(always)]
+            fn $f(self, o: f64) -> Z32x8 {
+                Z32x8(self.0 $op o)
+            }
+        }
+        impl $atr for Z32x8 {
+            #[inline(always)]
+            fn $af(&mut self, o: Z32x8) {
+                *self = *self $op o;
+            }
+        }
+    };
+}
+z32_binary!(Add, add, AddAssign, add_assign, +);
+z32_binary!(Sub, sub, SubAssign, sub_assign, -);
+z32_binary!(Mul, mul, MulAssign, mul_assign, *);
+z32_binary!(Div, div, DivAssign, div_assign, /);
+
+impl Neg for Z32x8 {
+    type Output = Z32x8;
+    #[inline(always)]
+    fn neg(self) -> Z32x8 {
+        Z32x8(-self.0)
+    }
+}
+
+impl Z32x8 {
+    /// A function of [`Z64x8`] applied to the lanes: widened, evaluated, narrowed.
+    #[inline(always)]
+    fn through(self, f: impl Fn(Z64x8) -> Z64x8) -> Z32x8 {
+        Z32x8::narrow(f(self.widen()))
+    }
+}
+
+impl Real for Z32x8 {
+    type Mask = M8f;
+    const LANES: usize = LANES;
+    type Wide = Z64x8;
+    #[inline(always)]
+    fn widen(self) -> Z64x8 {
+        // SAFETY: AVX-512 code only; `F32x8` is one 256-bit `f32x8` (exact conversion).
+        Z64x8(unsafe { _mm512_cvtps_pd(std::mem::transmute::<F32x8, __m256>(self.0)) })
+    }
+    #[inline(always)]
+    fn narrow(w: Z64x8) -> Self {
+        // Round to nearest (the default rounding mode), as `F32x8::narrow`'s `as f32`.
+        // SAFETY: AVX-512 code only.
+        Z32x8(unsafe { std::mem::transmute::<__m256, F32x8>(_mm512_cvtpd_ps(w.0)) })
+    }
+    #[inline(always)]
+    fn narrow_mask(m: ZM8) -> M8f {
+        // SAFETY: AVX-512 code only (AVX512DQ + VL): all bits set in the lanes of set bits.
+        unsafe { std::mem::transmute::<__m256i, M8f>(_mm256_movm_epi32(m.0)) }
+    }
+    #[inline(always)]
+    fn splat(x: f64) -> Self {
+        Z32x8(F32x8::splat(x))
+    }
+    #[inline(always)]
+    fn lane(self, i: usize) -> f64 {
+        self.0.lane(i)
+    }
+    #[inline(always)]
+    fn set_lane(&mut self, i: usize, x: f64) {
+        self.0.set_lane(i, x)
+    }
+    #[inline(always)]
+    fn from_slice(x: &[f64]) -> Self {
+        Z32x8(F32x8::from_slice(x))
+    }
+    #[inline(always)]
+    fn write_to(self, out: &mut [f64]) {
+        self.0.write_to(out)
+    }
+    #[inline(always)]
+    fn sqrt(self) -> Self {
+        Z32x8(self.0.sqrt())
+    }
+    #[inline(always)]
+    fn cbrt(self) -> Self {
+        self.through(Z64x8::cbrt)
+    }
+    #[inline(always)]
+    fn exp(self) -> Self {
+        self.through(Z64x8::exp)
+    }
+    #[inline(always)]
+    fn exp_m1(self) -> Self {
+        self.through(Z64x8::exp_m1)
+    }
+    #[inline(always)]
+    fn ln(self) -> Self {
+        self.through(Z64x8::ln)
+    }
+    #[inline(always)]
+    fn ln_1p(self) -> Self {
+        self.through(Z64x8::ln_1p)
+    }
+    #[inline(always)]
+    fn abs(self) -> Self {
+        Z32x8(self.0.abs())
+    }
+    #[inline(always)]
+    fn max(self, o: Self) -> Self {
+        Z32x8(self.0.max(o.0))
+    }
+    #[inline(always)]
+    fn min(self, o: Self) -> Self {
+        Z32x8(self.0.min(o.0))
+    }
+    #[inline(always)]
+    fn lt(self, o: Self) -> M8f {
+        self.0.lt(o.0)
+    }
+    #[inline(always)]
+    fn le(self, o: Self) -> M8f {
+        self.0.le(o.0)
+    }
+    #[inline(always)]
+    fn gt(self, o: Self) -> M8f {
+        self.0.gt(o.0)
+    }
+    #[inline(always)]
+    fn ge(self, o: Self) -> M8f {
+        self.0.ge(o.0)
+    }
+    #[inline(always)]
+    fn ne(self, o: Self) -> M8f {
+        self.0.ne(o.0)
+    }
+    #[inline(always)]
+    fn is_finite(self) -> M8f {
+        self.0.is_finite()
+    }
+    #[inline(always)]
+    fn select(m: M8f, a: Self, b: Self) -> Self {
+        Z32x8(F32x8::select(m, a.0, b.0))
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -443,6 +606,15 @@ mod tests {
                 let zm = za.lt(zb) | !za.is_finite();
                 assert!(same(F64x8::select(m, a, b), Z64x8::select(zm, za, zb)));
                 assert_eq!(m.any(), zm.any());
+                // the f32 lanes: conversions, masks, transcendentals through the wide type
+                let (n, zn) = (F32x8::narrow(a), Z32x8::narrow(za));
+                assert!(same(n.widen(), zn.widen()));
+                assert!(same(n.exp().widen(), zn.exp().widen()));
+                assert!(same(n.abs().ln().widen(), zn.abs().ln().widen()));
+                let (nm, znm) = (F32x8::narrow_mask(m), Z32x8::narrow_mask(zm));
+                for l in 0..LANES {
+                    assert_eq!(nm.lane(l), znm.lane(l));
+                }
             }
         }
     }

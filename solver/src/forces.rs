@@ -31,7 +31,7 @@ use crate::element::{fault_error, full, one_point, ElementOut, Formulation, Noda
 use crate::model::{ChunkOut, ElementTotals, Group, Part, CHUNK};
 use material::real::{F64x8, Mask, Real, LANES};
 #[cfg(target_arch = "x86_64")]
-use material::real_avx512::Z64x8;
+use material::real_avx512::{Z32x8, Z64x8};
 use material::real_f32::F32x8;
 use material::{with_law, Law};
 use rayon::prelude::*;
@@ -275,6 +275,9 @@ impl KernelLanes for Z64x8 {
 }
 
 impl KernelLanes for F32x8 {
+    #[cfg(target_arch = "x86_64")]
+    type Avx512 = Z32x8;
+    #[cfg(not(target_arch = "x86_64"))]
     type Avx512 = F32x8;
     #[inline(always)]
     fn refs(g: &Group) -> Refs<'_, Self> {
@@ -297,6 +300,28 @@ impl KernelLanes for F32x8 {
     #[inline(always)]
     fn history(h: &mut [F64x8]) -> &mut [F64x8] {
         h
+    }
+}
+
+#[cfg(target_arch = "x86_64")]
+impl KernelLanes for Z32x8 {
+    type Avx512 = Z32x8;
+    #[inline(always)]
+    fn refs(g: &Group) -> Refs<'_, Self> {
+        F32x8::refs(g).as_z32x8()
+    }
+    #[inline(always)]
+    fn nodal(x: &Nodal<F64x8>) -> Nodal<Self> {
+        let n = F32x8::nodal(x);
+        material::arr![3, |i| material::arr![8, |a| Z32x8(n[i][a])]]
+    }
+    #[inline(always)]
+    fn wide(x: F64x8) -> Z64x8 {
+        Z64x8::from_f64x8(x)
+    }
+    #[inline(always)]
+    fn history(h: &mut [F64x8]) -> &mut [Z64x8] {
+        <Z64x8 as KernelLanes>::history(h)
     }
 }
 

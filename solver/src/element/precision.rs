@@ -21,7 +21,7 @@
 use super::Nodal;
 use material::real::{F64x8, Real};
 #[cfg(target_arch = "x86_64")]
-use material::real_avx512::Z64x8;
+use material::real_avx512::{Z32x8, Z64x8};
 use material::real_f32::F32x8;
 
 /// The number type of the element kernels.
@@ -104,12 +104,26 @@ impl<'a> Refs<'a, F64x8> {
     }
 }
 
-/// A slice of arrays of [`F64x8`] as the same arrays of [`Z64x8`] (only [`Refs::as_z64x8`] calls
-/// it, with those types).
+impl<'a> Refs<'a, F32x8> {
+    /// The same data read as [`Z32x8`] lanes (a transparent wrapper of [`F32x8`]).
+    #[cfg(target_arch = "x86_64")]
+    pub fn as_z32x8(&self) -> Refs<'a, Z32x8> {
+        Refs {
+            grad: recast(self.grad),
+            gamma: recast(self.gamma),
+            hg_frame: recast(self.hg_frame),
+            hg_inv_len: recast(self.hg_inv_len),
+            gp_grad: recast(self.gp_grad),
+            gp_weight: recast(self.gp_weight),
+        }
+    }
+}
+
+/// A slice of arrays of [`F64x8`] as the same arrays of [`Z64x8`], or of [`F32x8`] as [`Z32x8`]
+/// (only [`Refs::as_z64x8`] and [`Refs::as_z32x8`] call it, with those types: each pair holds
+/// the same numbers in the same layout).
 #[cfg(target_arch = "x86_64")]
 fn recast<A, B>(x: &[A]) -> &[B] {
-    const { assert!(std::mem::size_of::<F64x8>() == std::mem::size_of::<Z64x8>()) };
-    const { assert!(std::mem::align_of::<F64x8>() >= std::mem::align_of::<Z64x8>()) };
     assert!(
         std::mem::size_of::<A>() == std::mem::size_of::<B>()
             && std::mem::align_of::<A>() >= std::mem::align_of::<B>()
