@@ -39,7 +39,13 @@ fn press(out: &Path, baseline: bool, extra: &[&str]) -> (Vec<u8>, Vec<u8>) {
 #[test]
 fn avx512_and_baseline_kernels_agree_bitwise() {
     #[cfg(target_arch = "x86_64")]
-    if !std::arch::is_x86_feature_detected!("avx512f") {
+    let avx512 = std::arch::is_x86_feature_detected!("avx512f")
+        && std::arch::is_x86_feature_detected!("avx512dq")
+        && std::arch::is_x86_feature_detected!("avx512vl")
+        && std::arch::is_x86_feature_detected!("avx512bw");
+    #[cfg(not(target_arch = "x86_64"))]
+    let avx512 = false;
+    if !avx512 {
         eprintln!("no AVX-512 on this processor: both runs would take the baseline path");
         return;
     }

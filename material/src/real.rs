@@ -3,11 +3,10 @@
 //! batched path ([`F64x8`], [`LANES`] points at once, struct-of-arrays inside the batch: the
 //! solver's element loop).
 //!
-//! [`F64x8`] is a plain `[f64; 8]` whose operators are lane-wise loops marked
-//! `#[inline(always)]`: LLVM turns each into one AVX-512 instruction (or two AVX2 ones) wherever
-//! the caller is compiled for those features, so the same source vectorises for whatever the
-//! solver's run-time dispatch selects (see the solver's `forces` module) and stays portable (SSE2,
-//! NEON, or scalar code on anything else). This is the "code shaped so that the compiler
+//! [`F64x8`] wraps the `wide` crate's `f64x8`, whose operators are vector instructions of the
+//! build's baseline (two AVX2 registers on the project's x86-64-v3, SSE2 or NEON elsewhere); the
+//! solver's AVX-512 path runs [`crate::real_avx512::Z64x8`] instead, the same operations in one
+//! 512-bit register (see the solver's `forces` module). This is the "code shaped so that the compiler
 //! vectorises it" route: `std::simd` needs nightly, and `pulp`'s closure-generic style would
 //! have to thread its `Simd` token through every law. `palpa bench` shows the result.
 //!

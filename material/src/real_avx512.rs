@@ -14,9 +14,9 @@
 //! undefined behaviour, which is why only the solver's AVX-512 dispatch path names it.
 //!
 //! Every operation is the IEEE operation [`F64x8`] performs, in the same order, with the same
-//! comparison predicates and the same `max`/`min` operand order (`wide`'s `max`: `rhs` if it is
-//! NaN, else `vmaxpd(self, rhs)`). So the two types give bitwise the same results, and a run's
-//! numbers do not depend on the processor it ran on; `tests` below and the solver's
+//! comparison predicates and the same `max`/`min` operand order (`wide`'s `max`: `self` where
+//! `rhs` is NaN, else `vmaxpd(self, rhs)`). So the two types give bitwise the same results, and a run's
+//! numbers do not depend on the processor it ran on; `tests` below and the `palpa` package's
 //! `tests/simd_paths.rs` check it. [`Z32x8`] is the same idea for the `f32` kernels: their
 //! lanes as [`F32x8`]'s, their laws in [`Z64x8`]. The transcendentals are the same generic functions as
 //! [`F64x8`]'s ([`exp_lanes`], [`ln_lanes`], ...; [`LaneBits`] gives their bit operations on
@@ -34,7 +34,12 @@ use std::ops::{
     SubAssign,
 };
 
-/// Eight `f64` lanes in one AVX-512 register (see the module doc for where it may be used).
+/// Eight `f64` lanes in one AVX-512 register.
+///
+/// Contract: construct and use it only on a processor with AVX-512 F, DQ, VL and BW (the
+/// solver's `forces::simd_level` checks them before its AVX-512 path, the only user); elsewhere
+/// its intrinsics are undefined behaviour. The constructors are safe functions so that the
+/// generic law and element code can call them; the type is not meant for other callers.
 #[derive(Clone, Copy)]
 #[repr(transparent)]
 pub struct Z64x8(pub __m512d);
@@ -78,14 +83,14 @@ impl Z64x8 {
         // SAFETY: AVX-512 code only.
         ZM8(unsafe { _mm512_cmp_pd_mask::<P>(self.0, o.0) })
     }
-    /// `wide`'s `f64x8::max`: `o` where it is NaN, else `vmaxpd(self, o)`.
+    /// `wide`'s `f64x8::max`: `self` where `o` is NaN, else `vmaxpd(self, o)`.
     #[inline(always)]
     fn wide_max(self, o: Z64x8) -> Z64x8 {
         // SAFETY: AVX-512 code only.
         let m = Z64x8(unsafe { _mm512_max_pd(self.0, o.0) });
         Z64x8::select(o.cmp::<_CMP_UNORD_Q>(o), self, m)
     }
-    /// `wide`'s `f64x8::min`: `o` where it is NaN, else `vminpd(self, o)`.
+    /// `wide`'s `f64x8::min`: `self` where `o` is NaN, else `vminpd(self, o)`.
     #[inline(always)]
     fn wide_min(self, o: Z64x8) -> Z64x8 {
         // SAFETY: AVX-512 code only.
@@ -570,6 +575,8 @@ mod tests {
     fn z64x8_is_bitwise_f64x8() {
         if !std::arch::is_x86_feature_detected!("avx512f")
             || !std::arch::is_x86_feature_detected!("avx512dq")
+            || !std::arch::is_x86_feature_detected!("avx512vl")
+            || !std::arch::is_x86_feature_detected!("avx512bw")
         {
             eprintln!("no AVX-512 here: nothing to compare");
             return;

@@ -13,6 +13,7 @@ use material::quantity::Length;
 use phantom::Phantom;
 use solver::generate::{box_mesh, BoxSpec};
 use solver::mesh::Mesh;
+use solver::renumber::{renumber, Numbering};
 use std::path::Path;
 
 /// A scene error with its location ([`Locate::err`]).
@@ -198,6 +199,39 @@ pub fn build_scene_with(
 
 pub use super::output_plan::DEFAULT_MAX_OUTPUTS;
 
+/// `[mesh] numbering`, checked before the mesh is read or generated: how a box or file mesh's
+/// nodes are to be numbered ([`solver::renumber`]). The phantom's nodes stay as its generator
+/// numbers them (its ROI and liver surface refer to them).
+fn numbering(spec: &MeshSpec, at: Locate) -> Result<Numbering, String> {
+    let Some(label) = &spec.numbering else {
+        return Ok(Numbering::AsGiven);
+    };
+    let needle = format!("\"{label}\"");
+    let how =
+        Numbering::parse(label).map_err(|m| at.err("mesh.numbering", Some(needle.as_str()), &m))?;
+    if how != Numbering::AsGiven && spec.generator.as_deref() == Some("phantom") {
+        return Err(at.err(
+            "mesh.numbering",
+            Some(needle.as_str()),
+            &"the phantom's nodes are numbered by its generator (its ROI and liver surface refer \
+             to them): `numbering` applies to box and file meshes",
+        ));
+    }
+    Ok(how)
+}
+
+/// Number the mesh's nodes as [`numbering`] said, noting the element bandwidth before and after.
+fn number_nodes(how: Numbering, mesh: &mut Mesh, notes: &mut Vec<String>) {
+    if how == Numbering::AsGiven {
+        return;
+    }
+    let (before, after) = renumber(mesh, how, 1);
+    notes.push(format!(
+        "nodes numbered {}: element bandwidth {before} -> {after}",
+        how.label()
+    ));
+}
+
 /// Resolve a parsed scene to SI ([`SceneDef`]): the mesh with its node sets, the parts' laws,
 /// boundary conditions, loads, settings, output and contact. [`super::def::assemble`] builds
 /// the model from it.
@@ -210,6 +244,7 @@ pub fn resolve_scene(
     let at = Locate { path, src };
     let (end_time, dt_factor, precision) = run_control(&spec.run, at)?;
     let mut notes = Vec::new();
+    let how_numbered = numbering(&spec.mesh, at)?;
     let (mut mesh, mut phantom) = read_mesh(&spec.mesh, path, src, prebuilt, &mut notes)?;
     for (i, h) in spec.hands.iter_mut().enumerate() {
         place_hand(h, phantom.as_ref())
@@ -220,6 +255,9 @@ pub fn resolve_scene(
         ph.mesh = Mesh::default();
     }
     add_node_sets(&spec.node_sets, &mut mesh, at)?;
+    // after the scene's own node sets (explicit ids name the mesh's numbering), which
+    // renumbering carries with the nodes
+    number_nodes(how_numbered, &mut mesh, &mut notes);
     let parts = part_defs(&spec, &mesh, at, &mut notes)?;
     let constraints = kinematics::constraints(&spec, &mesh, at)?;
     let loads = kinematics::loads(&spec, &mesh, at)?;

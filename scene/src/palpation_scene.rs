@@ -217,6 +217,7 @@ impl PalpationSetup {
                 part: None,
                 max_elements: None,
                 phantom: Some(self.phantom_scene()),
+                numbering: None,
             },
             materials,
             parts,

@@ -115,6 +115,9 @@ pub struct MeshSpec {
     pub max_elements: Option<Number>,
     /// Phantom: `[mesh.phantom]` (with `generator = "phantom"`).
     pub phantom: Option<super::phantom_spec::PhantomScene>,
+    /// Node numbering: `as_given` (default), `rcm` (reverse Cuthill-McKee) or `shuffled` (a
+    /// seeded random order, to measure what locality is worth); box and file meshes only.
+    pub numbering: Option<String>,
 }
 
 /// `[[part]]`.

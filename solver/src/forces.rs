@@ -9,8 +9,12 @@
 //! history are stored batch by batch in the same lane layout ([`crate::model::Group`]), so they
 //! load as whole vectors. The batch kernel is compiled twice: for AVX-512 (chosen at run time when
 //! the processor has it) and for the build's baseline (AVX2 with the project's `.cargo/config.toml`,
-//! SSE2 or NEON elsewhere); both perform the same IEEE operations in the same order, so results
-//! do not depend on which runs. `PALPA_SIMD=baseline` forces the baseline path.
+//! SSE2 or NEON elsewhere). The AVX-512 path runs its own lane types (`Z64x8`, `Z32x8` of
+//! `material::real_avx512`: eight `f64` in one 512-bit register where `wide`'s `f64x8` is two
+//! 256-bit halves on the baseline build); both paths perform the same IEEE operations in the
+//! same order, so results do not depend on which runs (the `palpa` package's
+//! `tests/simd_paths.rs` compares whole runs byte for byte). `PALPA_SIMD=baseline` forces the
+//! baseline path.
 //!
 //! Assembly: the elements of a group are cut into chunks of [`CHUNK`], and the chunks are
 //! coloured so that no two chunks of one colour share a node ([`crate::model::Group::colours`]).
@@ -114,8 +118,7 @@ pub fn element_loop(
         "element_loop: an element refers to a node beyond x_ref"
     );
     if let Some(s) = &stress {
-        // A group's global ids ascend (the model collects them in mesh order).
-        let ne = groups.iter().filter_map(|g| g.elements.last()).max();
+        let ne = groups.iter().flat_map(|g| g.elements.iter()).max();
         assert!(
             ne.is_none_or(|&e| (e as usize) < s.len()),
             "element_loop: stress is too short"

@@ -14,6 +14,7 @@ pub mod mesh;
 pub mod mesh_io;
 pub mod model;
 pub mod output;
+pub mod renumber;
 pub mod simulation;
 
 pub use mesh::Mesh;

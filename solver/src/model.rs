@@ -610,9 +610,14 @@ impl Model {
         };
         let mut groups = Vec::new();
         for (pi, part) in parts.iter().enumerate() {
-            let elems: Vec<u32> = (0..mesh.elements.len() as u32)
+            let mut elems: Vec<u32> = (0..mesh.elements.len() as u32)
                 .filter(|&e| mesh.element_part[e as usize] as usize == pi)
                 .collect();
+            // Element order for locality: by lowest node, then by number. A raster-numbered
+            // mesh (the box generator's, the phantom's voxels) keeps its order; after a
+            // renumbering (`crate::renumber`) the elements follow their nodes.
+            let lowest = |e: u32| *mesh.elements[e as usize].iter().min().unwrap();
+            elems.sort_by_key(|&e| (lowest(e), e));
             if elems.is_empty() {
                 continue;
             }

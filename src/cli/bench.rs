@@ -18,6 +18,10 @@
 //! - `ogden`: the same block of the paper's liver (Ogden, exponents 19 and -11, three Prony
 //!   terms), one-point elements with shear-scaled stiffness hourglass control, top velocity load.
 //!
+//! `--numbering as_given,shuffled,rcm` runs every case with the block's nodes as generated
+//! (a raster), in a seeded random order and renumbered by reverse Cuthill-McKee
+//! ([`solver::renumber`]): what locality is worth, and what RCM recovers.
+//!
 //! The memory roof: a STREAM-style triad `a = b + s c` over 3 x 64 MB, run on the same threads
 //! just before each case, gives the bandwidth; the bytes a step moves per element (its reference
 //! data, history read and written, and nodal arrays: three gathered, the force array added into
@@ -29,6 +33,7 @@
 use scene::build::build_scene;
 use scene::SceneSpec;
 use solver::element::precision::Precision;
+use solver::renumber::Numbering;
 use std::path::Path;
 use std::time::Instant;
 
@@ -49,7 +54,7 @@ fix = ["all"]
 vtk = false
 "#;
 
-fn case_scene(case: &str, precision: Precision) -> Result<String, String> {
+fn case_scene(case: &str, precision: Precision, numbering: Numbering) -> Result<String, String> {
     let nh = r#"
 [materials.nh]
 law = "neo_hookean"
@@ -100,8 +105,12 @@ surface = "zmax"
             ))
         }
     };
+    let block = BLOCK.replace(
+        "part = \"body\"\n",
+        &format!("part = \"body\"\nnumbering = \"{}\"\n", numbering.label()),
+    );
     Ok(format!(
-        "[run]\ntitle = \"bench {case}\"\nend_time = \"1 s\"\nprecision = \"{}\"\n{BLOCK}{body}",
+        "[run]\ntitle = \"bench {case}\"\nend_time = \"1 s\"\nprecision = \"{}\"\n{block}{body}",
         precision.label()
     ))
 }
@@ -165,8 +174,9 @@ fn measure(
     threads: usize,
     steps: usize,
     precision: Precision,
+    numbering: Numbering,
 ) -> Result<Measured, String> {
-    let src = case_scene(case, precision)?;
+    let src = case_scene(case, precision, numbering)?;
     let spec: SceneSpec = toml::from_str(&src).map_err(|e| format!("bench scene {case}: {e}"))?;
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(threads)
@@ -207,10 +217,15 @@ pub fn bench(
     threads: &[usize],
     steps: usize,
     precisions: &[String],
+    numberings: &[String],
 ) -> Result<(), String> {
     let precisions = precisions
         .iter()
         .map(|p| Precision::parse(p).map_err(|e| format!("--precision: {e}")))
+        .collect::<Result<Vec<_>, _>>()?;
+    let numberings = numberings
+        .iter()
+        .map(|n| Numbering::parse(n).map_err(|e| format!("--numbering: {e}")))
         .collect::<Result<Vec<_>, _>>()?;
     if steps == 0 {
         return Err("--steps must be at least 1".into());
@@ -224,7 +239,7 @@ pub fn bench(
         solver::forces::simd_level()
     );
     println!(
-        "{:<8} {:>4} {:>7} {:>9} {:>9} {:>12} {:>8} {:>7} {:>9} {:>10} {:>7}  stage shares",
+        "{:<16} {:>4} {:>7} {:>9} {:>9} {:>12} {:>8} {:>7} {:>9} {:>10} {:>7}  stage shares",
         "case",
         "prec",
         "threads",
@@ -237,13 +252,21 @@ pub fn bench(
         "roof M/s",
         "of roof"
     );
-    for (case, p) in cases
-        .iter()
-        .flat_map(|c| precisions.iter().map(move |p| (c, *p)))
-    {
+    let runs = cases.iter().flat_map(|c| {
+        let numberings = &numberings;
+        precisions
+            .iter()
+            .flat_map(move |p| numberings.iter().map(move |n| (c, *p, *n)))
+    });
+    for (case, p, n) in runs {
         let mut base = None;
+        // the case, and its numbering where it is not the block's own
+        let label = match n {
+            Numbering::AsGiven => case.clone(),
+            _ => format!("{case}/{}", n.label()),
+        };
         for &t in threads {
-            let m = measure(case, t, steps, p)?;
+            let m = measure(case, t, steps, p, n)?;
             let rate = (m.elements * steps) as f64 / m.seconds;
             let speedup = match base {
                 None => {
@@ -259,7 +282,7 @@ pub fn bench(
                 .collect();
             let roof = m.bandwidth / m.bytes_per_element;
             println!(
-                "{case:<8} {:>4} {t:>7} {:>9} {:>9.3} {:>12.3} {:>8.2} {:>7.0} {:>10.1} {:>10.1} {:>6.0} %  {}",
+                "{label:<16} {:>4} {t:>7} {:>9} {:>9.3} {:>12.3} {:>8.2} {:>7.0} {:>10.1} {:>10.1} {:>6.0} %  {}",
                 p.label(),
                 m.elements,
                 m.seconds,
@@ -283,9 +306,12 @@ mod tests {
     #[test]
     fn every_case_scene_parses() {
         for c in ["nh-1pt", "nh-fbar", "press", "ogden"] {
-            let src = case_scene(c, Precision::F32).unwrap();
-            let _: SceneSpec = toml::from_str(&src).unwrap();
+            for n in [Numbering::AsGiven, Numbering::Rcm] {
+                let src = case_scene(c, Precision::F32, n).unwrap();
+                let _: SceneSpec = toml::from_str(&src).unwrap();
+                assert!(src.contains(&format!("numbering = \"{}\"", n.label())));
+            }
         }
-        assert!(case_scene("nope", Precision::F64).is_err());
+        assert!(case_scene("nope", Precision::F64, Numbering::AsGiven).is_err());
     }
 }

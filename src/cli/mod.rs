@@ -179,6 +179,10 @@ enum Command {
         /// Element-kernel precisions to compare: f64, f32 or both (`f64,f32`).
         #[arg(long, value_delimiter = ',', default_values_t = ["f64".to_string()])]
         precision: Vec<String>,
+        /// Node numberings to compare: as_given (the block's raster), rcm (reverse
+        /// Cuthill-McKee), shuffled (a seeded random order); e.g. `as_given,shuffled,rcm`.
+        #[arg(long, value_delimiter = ',', default_values_t = ["as_given".to_string()])]
+        numbering: Vec<String>,
     },
 }
 
@@ -267,6 +271,7 @@ pub fn dispatch(cli: Cli) -> Result<(), String> {
             threads,
             steps,
             precision,
-        } => bench::bench(&cases, &threads, steps, &precision),
+            numbering,
+        } => bench::bench(&cases, &threads, steps, &precision, &numbering),
     }
 }

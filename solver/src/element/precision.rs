@@ -94,12 +94,13 @@ impl<'a> Refs<'a, F64x8> {
     #[cfg(target_arch = "x86_64")]
     pub fn as_z64x8(&self) -> Refs<'a, Z64x8> {
         Refs {
-            grad: recast(self.grad),
-            gamma: recast(self.gamma),
-            hg_frame: recast(self.hg_frame),
-            hg_inv_len: recast(self.hg_inv_len),
-            gp_grad: recast(self.gp_grad),
-            gp_weight: recast(self.gp_weight),
+            // SAFETY: the same arrays of a lane type of the same numbers and layout (`recast`).
+            grad: unsafe { recast(self.grad) },
+            gamma: unsafe { recast(self.gamma) },
+            hg_frame: unsafe { recast(self.hg_frame) },
+            hg_inv_len: unsafe { recast(self.hg_inv_len) },
+            gp_grad: unsafe { recast(self.gp_grad) },
+            gp_weight: unsafe { recast(self.gp_weight) },
         }
     }
 }
@@ -109,26 +110,28 @@ impl<'a> Refs<'a, F32x8> {
     #[cfg(target_arch = "x86_64")]
     pub fn as_z32x8(&self) -> Refs<'a, Z32x8> {
         Refs {
-            grad: recast(self.grad),
-            gamma: recast(self.gamma),
-            hg_frame: recast(self.hg_frame),
-            hg_inv_len: recast(self.hg_inv_len),
-            gp_grad: recast(self.gp_grad),
-            gp_weight: recast(self.gp_weight),
+            // SAFETY: the same arrays of a lane type of the same numbers and layout (`recast`).
+            grad: unsafe { recast(self.grad) },
+            gamma: unsafe { recast(self.gamma) },
+            hg_frame: unsafe { recast(self.hg_frame) },
+            hg_inv_len: unsafe { recast(self.hg_inv_len) },
+            gp_grad: unsafe { recast(self.gp_grad) },
+            gp_weight: unsafe { recast(self.gp_weight) },
         }
     }
 }
 
-/// A slice of arrays of [`F64x8`] as the same arrays of [`Z64x8`], or of [`F32x8`] as [`Z32x8`]
-/// (only [`Refs::as_z64x8`] and [`Refs::as_z32x8`] call it, with those types: each pair holds
-/// the same numbers in the same layout).
+/// A slice of arrays of [`F64x8`] as the same arrays of [`Z64x8`], or of [`F32x8`] as [`Z32x8`].
+///
+/// # Safety
+/// `A` and `B` must hold the same numbers in the same layout, every bit pattern of `A` being a
+/// valid `B`: [`Refs::as_z64x8`] and [`Refs::as_z32x8`] call it with those pairs only. Size and
+/// alignment are checked at compile time.
 #[cfg(target_arch = "x86_64")]
-fn recast<A, B>(x: &[A]) -> &[B] {
-    assert!(
-        std::mem::size_of::<A>() == std::mem::size_of::<B>()
-            && std::mem::align_of::<A>() >= std::mem::align_of::<B>()
-    );
-    // SAFETY: same size and no stricter alignment (checked); every bit pattern is a valid f64.
+unsafe fn recast<A, B>(x: &[A]) -> &[B] {
+    const { assert!(std::mem::size_of::<A>() == std::mem::size_of::<B>()) };
+    const { assert!(std::mem::align_of::<A>() >= std::mem::align_of::<B>()) };
+    // SAFETY: same size, no stricter alignment (checked above), same lanes (the caller).
     unsafe { std::slice::from_raw_parts(x.as_ptr() as *const B, x.len()) }
 }
 
