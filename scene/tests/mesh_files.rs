@@ -181,63 +181,15 @@ fn refusals_name_what_is_wrong() {
     );
 }
 
-/// Uniaxial compression of the block on rollers, 5 % in x over 20 ms (neo-Hookean, both parts
-/// the same material), from the mesh given by `mesh` (a `[mesh]` table body); the final x0
+/// Uniaxial compression of the block on rollers ([`common::roller_compression`]); the final x0
 /// support reaction (N).
 fn compression(mesh: &str, parts: [&str; 2]) -> f64 {
-    let src = format!(
-        r#"
-[run]
-end_time = "25 ms"
-[mesh]
-{mesh}
-[materials.m]
-law = "neo_hookean"
-density = "1000 kg/m^3"
-youngs_modulus = "1 MPa"
-poisson_ratio = 0.3
-[[part]]
-name = "{}"
-material = "m"
-[[part]]
-name = "{}"
-material = "m"
-[node_sets.x0]
-plane_axis = "x"
-plane_value = "0 mm"
-[node_sets.x1]
-plane_axis = "x"
-plane_value = "30 mm"
-[node_sets.y0]
-plane_axis = "y"
-plane_value = "0 mm"
-[node_sets.z0]
-plane_axis = "z"
-plane_value = "0 mm"
-[[boundary]]
-nodes = "x0"
-symmetry = "x"
-[[boundary]]
-nodes = "y0"
-symmetry = "y"
-[[boundary]]
-nodes = "z0"
-symmetry = "z"
-[[boundary]]
-nodes = "x1"
-displacement = {{ x = {{ kind = "smooth_step", value = "-1.5 mm", end = "20 ms" }} }}
-[output]
-history_interval = "1 ms"
-reactions = ["x0"]
-"#,
-        parts[0], parts[1]
-    );
-    let mut scene = common::scene_from_str(&src);
-    let (cols, rows) = common::run_to_end(&mut scene, "mesh-file");
-    *solver::output::history::column(&cols, &rows, "x0_reaction_x")
-        .unwrap()
-        .last()
-        .unwrap()
+    common::roller_compression(
+        mesh,
+        &parts,
+        "plane_axis = \"x\"\nplane_value = \"0 mm\"",
+        "mesh-file",
+    )
 }
 
 /// Closed form of the neo-Hookean bar in uniaxial stress (as in compression_block.rs).

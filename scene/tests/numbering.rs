@@ -41,57 +41,15 @@ fn reaction(numbering: &str, explicit: bool) -> f64 {
     } else {
         "plane_axis = \"x\"\nplane_value = \"0 mm\"".to_string()
     };
-    let src = format!(
-        r#"
-[run]
-end_time = "25 ms"
-[mesh]
-generator = "box"
-size = ["30 mm", "20 mm", "40 mm"]
-divisions = [3, 2, 4]
-numbering = "{numbering}"
-[materials.m]
-law = "neo_hookean"
-density = "1000 kg/m^3"
-youngs_modulus = "1 MPa"
-poisson_ratio = 0.3
-[[part]]
-name = "body"
-material = "m"
-[node_sets.x0]
-{x0}
-[node_sets.x1]
-plane_axis = "x"
-plane_value = "30 mm"
-[node_sets.y0]
-plane_axis = "y"
-plane_value = "0 mm"
-[node_sets.z0]
-plane_axis = "z"
-plane_value = "0 mm"
-[[boundary]]
-nodes = "x0"
-symmetry = "x"
-[[boundary]]
-nodes = "y0"
-symmetry = "y"
-[[boundary]]
-nodes = "z0"
-symmetry = "z"
-[[boundary]]
-nodes = "x1"
-displacement = {{ x = {{ kind = "smooth_step", value = "-1.5 mm", end = "20 ms" }} }}
-[output]
-history_interval = "1 ms"
-reactions = ["x0"]
-"#
-    );
-    let mut scene = common::scene_from_str(&src);
-    let (cols, rows) = common::run_to_end(&mut scene, &format!("numbering-{numbering}"));
-    *solver::output::history::column(&cols, &rows, "x0_reaction_x")
-        .unwrap()
-        .last()
-        .unwrap()
+    common::roller_compression(
+        &format!(
+            "generator = \"box\"\nsize = [\"30 mm\", \"20 mm\", \"40 mm\"]\n\
+             divisions = [3, 2, 4]\nnumbering = \"{numbering}\""
+        ),
+        &["body"],
+        &x0,
+        &format!("numbering-{numbering}"),
+    )
 }
 
 #[test]

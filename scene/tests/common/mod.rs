@@ -44,3 +44,60 @@ pub fn interpolate_at(x: &[f64], y: &[f64], x0: f64) -> f64 {
     let (xa, xb, ya, yb) = (x[i - 1], x[i], y[i - 1], y[i]);
     ya + (yb - ya) * (x0 - xa) / (xb - xa)
 }
+
+/// Uniaxial compression of a 30 mm long block on rollers, 5 % in x over 20 ms (neo-Hookean,
+/// every part the same material), from the mesh given by `mesh` (a `[mesh]` table body), with
+/// the parts `parts` and the x = 0 node set given by `x0` (a `[node_sets.x0]` table body); the
+/// final x0 support reaction (N).
+pub fn roller_compression(mesh: &str, parts: &[&str], x0: &str, name: &str) -> f64 {
+    let part_tables: String = parts
+        .iter()
+        .map(|p| format!("[[part]]\nname = \"{p}\"\nmaterial = \"m\"\n"))
+        .collect();
+    let src = format!(
+        r#"
+[run]
+end_time = "25 ms"
+[mesh]
+{mesh}
+[materials.m]
+law = "neo_hookean"
+density = "1000 kg/m^3"
+youngs_modulus = "1 MPa"
+poisson_ratio = 0.3
+{part_tables}
+[node_sets.x0]
+{x0}
+[node_sets.x1]
+plane_axis = "x"
+plane_value = "30 mm"
+[node_sets.y0]
+plane_axis = "y"
+plane_value = "0 mm"
+[node_sets.z0]
+plane_axis = "z"
+plane_value = "0 mm"
+[[boundary]]
+nodes = "x0"
+symmetry = "x"
+[[boundary]]
+nodes = "y0"
+symmetry = "y"
+[[boundary]]
+nodes = "z0"
+symmetry = "z"
+[[boundary]]
+nodes = "x1"
+displacement = {{ x = {{ kind = "smooth_step", value = "-1.5 mm", end = "20 ms" }} }}
+[output]
+history_interval = "1 ms"
+reactions = ["x0"]
+"#
+    );
+    let mut scene = scene_from_str(&src);
+    let (cols, rows) = run_to_end(&mut scene, name);
+    *solver::output::history::column(&cols, &rows, "x0_reaction_x")
+        .unwrap()
+        .last()
+        .unwrap()
+}

@@ -93,15 +93,8 @@ impl<'a> Refs<'a, F64x8> {
     /// aligned to 64 bytes, as `Z64x8` needs, and both are eight `f64`).
     #[cfg(target_arch = "x86_64")]
     pub fn as_z64x8(&self) -> Refs<'a, Z64x8> {
-        Refs {
-            // SAFETY: the same arrays of a lane type of the same numbers and layout (`recast`).
-            grad: unsafe { recast(self.grad) },
-            gamma: unsafe { recast(self.gamma) },
-            hg_frame: unsafe { recast(self.hg_frame) },
-            hg_inv_len: unsafe { recast(self.hg_inv_len) },
-            gp_grad: unsafe { recast(self.gp_grad) },
-            gp_weight: unsafe { recast(self.gp_weight) },
-        }
+        // SAFETY: the same numbers in the same layout.
+        unsafe { self.recast() }
     }
 }
 
@@ -109,14 +102,28 @@ impl<'a> Refs<'a, F32x8> {
     /// The same data read as [`Z32x8`] lanes (a transparent wrapper of [`F32x8`]).
     #[cfg(target_arch = "x86_64")]
     pub fn as_z32x8(&self) -> Refs<'a, Z32x8> {
-        Refs {
-            // SAFETY: the same arrays of a lane type of the same numbers and layout (`recast`).
-            grad: unsafe { recast(self.grad) },
-            gamma: unsafe { recast(self.gamma) },
-            hg_frame: unsafe { recast(self.hg_frame) },
-            hg_inv_len: unsafe { recast(self.hg_inv_len) },
-            gp_grad: unsafe { recast(self.gp_grad) },
-            gp_weight: unsafe { recast(self.gp_weight) },
+        // SAFETY: the same numbers in the same layout.
+        unsafe { self.recast() }
+    }
+}
+
+impl<'a, A> Refs<'a, A> {
+    /// Every array read as the same arrays of `B`.
+    ///
+    /// # Safety
+    /// As [`recast`].
+    #[cfg(target_arch = "x86_64")]
+    unsafe fn recast<B>(&self) -> Refs<'a, B> {
+        // SAFETY: passed on to the caller.
+        unsafe {
+            Refs {
+                grad: recast(self.grad),
+                gamma: recast(self.gamma),
+                hg_frame: recast(self.hg_frame),
+                hg_inv_len: recast(self.hg_inv_len),
+                gp_grad: recast(self.gp_grad),
+                gp_weight: recast(self.gp_weight),
+            }
         }
     }
 }
