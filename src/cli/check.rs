@@ -155,10 +155,25 @@ pub fn check(path: &Path, deck: &DeckArgs, pilot: Pilot) -> Result<(), String> {
             g.elements.len().div_ceil(solver::model::CHUNK),
         );
     }
+    println!("{}", numbering_line(&m.mesh));
     println!("  stages: {}", sim.active_stages().join(", "));
     let elements = mesh.elements.len();
     print_pilot(path, &scene, pilot, lsdyna::is_deck(path), elements);
     Ok(())
+}
+
+/// The mesh's element bandwidth (the largest node-number spread of one element), with a hint
+/// where it spans most of the nodes: a numbering without locality, which costs the element loop
+/// its cache and its parallel colours (docs/performance.md, node numbering).
+fn numbering_line(mesh: &solver::Mesh) -> String {
+    let bw = solver::renumber::bandwidth(mesh);
+    let n = mesh.n_nodes();
+    let hint = if n > 64 && (bw as usize) * 4 > n * 3 {
+        ": the nodes are numbered without locality; `[mesh] numbering = \"rcm\"` renumbers them"
+    } else {
+        ""
+    };
+    format!("  node numbering: element bandwidth {bw} of {n} nodes{hint}")
 }
 
 /// Run the pilot when asked or cheap and print its estimate, or why there is none.
