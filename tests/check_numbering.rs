@@ -2,45 +2,22 @@
 //! where the numbering has no locality: a 10 x 10 x 10 block shuffled gets the hint, the same
 //! block as generated (a raster) and renumbered by RCM do not.
 
-use std::process::Command;
+#[path = "support/block.rs"]
+mod block;
+#[path = "support/cli.rs"]
+mod cli;
 
-/// `palpa check`'s node-numbering line for the block numbered `numbering`.
+/// `palpa check`'s node-numbering line for the shared block at 10 x 10 x 10, numbered
+/// `numbering`.
 fn numbering_line(numbering: &str) -> String {
     let dir = tempfile::tempdir().unwrap();
     let scene = dir.path().join("block.toml");
-    std::fs::write(
-        &scene,
-        format!(
-            r#"[run]
-end_time = "1 ms"
-[mesh]
-generator = "box"
-size = ["10 mm", "10 mm", "10 mm"]
-divisions = [10, 10, 10]
-numbering = "{numbering}"
-[materials.m]
-law = "neo_hookean"
-density = "1000 kg/m^3"
-youngs_modulus = "1 MPa"
-poisson_ratio = 0.3
-[[part]]
-name = "body"
-material = "m"
-"#
-        ),
-    )
-    .unwrap();
-    let out = Command::new(env!("CARGO_BIN_EXE_palpa"))
-        .arg("check")
-        .arg(&scene)
-        .output()
-        .unwrap();
-    let stdout = String::from_utf8_lossy(&out.stdout).into_owned();
-    assert!(
-        out.status.success(),
-        "{stdout}{}",
-        String::from_utf8_lossy(&out.stderr)
+    let src = block::BLOCK.replace(
+        "divisions = [2, 2, 2]",
+        &format!("divisions = [10, 10, 10]\nnumbering = \"{numbering}\""),
     );
+    std::fs::write(&scene, src).unwrap();
+    let stdout = cli::ok(&["check", cli::s(&scene)]);
     stdout
         .lines()
         .find(|l| l.contains("node numbering"))

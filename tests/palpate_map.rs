@@ -3,30 +3,16 @@
 //! and the colour of the largest ROI stress of the last sample (from `roi_stress.csv`) on its
 //! scale, which the cell drawn last (the largest) must show.
 
+#[path = "support/cli.rs"]
+mod cli;
+
 use std::path::Path;
-use std::process::{Command, Output};
+use std::process::Output;
 use surrogate::ColourScale;
 
-/// A quick coarse press into `out`: 8 mm voxels, `depth` in a time of the same number of ms,
-/// samples every 1 ms, no VTK, and the `extra` options.
+/// A quick coarse press into `out` ([`cli::coarse_press`]), run.
 fn coarse_press(out: &Path, depth_mm: u32, extra: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_palpa"))
-        .arg("palpate")
-        .args(extra)
-        .args([
-            "--voxel",
-            "8mm",
-            "--sample-interval",
-            "1ms",
-            "--no-vtk",
-            "--quiet",
-        ])
-        .args(["--duration", &format!("{depth_mm}ms")])
-        .args(["--depth", &format!("{depth_mm}mm")])
-        .arg("--out")
-        .arg(out)
-        .output()
-        .unwrap()
+    cli::coarse_press(out, depth_mm, extra).output().unwrap()
 }
 
 #[test]

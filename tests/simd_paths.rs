@@ -5,25 +5,14 @@
 //! On a processor without AVX-512 both runs take the baseline path and the test shows nothing
 //! (it says so).
 
-use std::path::Path;
-use std::process::Command;
+#[path = "support/cli.rs"]
+mod cli;
 
-/// `history.csv` and `roi_stress.csv` of a coarse press with `extra` options.
+use std::path::Path;
+
+/// `history.csv` and `roi_stress.csv` of a coarse press (3 mm in 3 ms) with `extra` options.
 fn press(out: &Path, baseline: bool, extra: &[&str]) -> (Vec<u8>, Vec<u8>) {
-    let mut c = Command::new(env!("CARGO_BIN_EXE_palpa"));
-    c.arg("palpate").args(extra).args([
-        "--voxel",
-        "8mm",
-        "--depth",
-        "3mm",
-        "--duration",
-        "3ms",
-        "--sample-interval",
-        "1ms",
-        "--no-vtk",
-        "--quiet",
-    ]);
-    c.arg("--out").arg(out);
+    let mut c = cli::coarse_press(out, 3, extra);
     if baseline {
         c.env("PALPA_SIMD", "baseline");
     } else {

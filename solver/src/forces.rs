@@ -228,6 +228,11 @@ trait KernelLanes: Real {
     fn wide(x: F64x8) -> Self::Wide;
     /// A batch's stored history in the law's number type.
     fn history(h: &mut [F64x8]) -> &mut [Self::Wide];
+    /// Per-element `f64` lanes (volume, hourglass scale, density scale) in the kernel's type.
+    #[inline(always)]
+    fn per_element(x: F64x8) -> Self {
+        Self::narrow(Self::wide(x))
+    }
 }
 
 impl KernelLanes for F64x8 {
@@ -262,7 +267,7 @@ impl KernelLanes for Z64x8 {
     }
     #[inline(always)]
     fn nodal(x: &Nodal<F64x8>) -> Nodal<Self> {
-        material::arr![3, |i| material::arr![8, |a| Z64x8::from_f64x8(x[i][a])]]
+        material::arr![3, |i| material::arr![8, |a| Self::wide(x[i][a])]]
     }
     #[inline(always)]
     fn wide(x: F64x8) -> Z64x8 {
@@ -383,7 +388,7 @@ fn batch_forces<L: Law, G: GatherLanes, R: KernelLanes>(
     let xr = G::lanes(b.x_ref, conn);
     let xe: Nodal<F64x8> = material::arr![3, |i| material::arr![8, |a| xr[i][a] + ue[i][a]]];
     let (ue, ve, xe) = (R::nodal(&ue), R::nodal(&ve), R::nodal(&xe));
-    let s = R::narrow(R::wide(density_scale));
+    let s = R::per_element(density_scale);
     // SAFETY: batch bi owns history[bi*stride..(bi+1)*stride] alone.
     let h = R::history(unsafe { b.hist.slice(bi * stride, stride) });
     match b.form {
@@ -391,8 +396,8 @@ fn batch_forces<L: Law, G: GatherLanes, R: KernelLanes>(
             let rf = one_point::OnePointRef {
                 grad: &refs.grad[bi],
                 gamma: &refs.gamma[bi],
-                vol0: R::narrow(R::wide(lanes_of(&g.vol0, le0))),
-                hg_scale: R::narrow(R::wide(lanes_of(&g.hg_scale, le0))),
+                vol0: R::per_element(lanes_of(&g.vol0, le0)),
+                hg_scale: R::per_element(lanes_of(&g.hg_scale, le0)),
                 physical: (!g.hg_frame.is_empty()).then(|| PhysicalRef {
                     frame: &refs.hg_frame[bi],
                     inv_len: &refs.hg_inv_len[bi],
@@ -408,7 +413,7 @@ fn batch_forces<L: Law, G: GatherLanes, R: KernelLanes>(
                 centre_grad: &refs.grad[bi],
                 gp_grad: &refs.gp_grad[bi],
                 gp_weight: &refs.gp_weight[bi],
-                vol0: R::narrow(R::wide(lanes_of(&g.vol0, le0))),
+                vol0: R::per_element(lanes_of(&g.vol0, le0)),
             };
             full::compute_forces(l, &rf, fbar, &xe, &ue, &ve, s, b.input, h, fe)
         }

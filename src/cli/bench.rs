@@ -37,14 +37,18 @@ use solver::renumber::Numbering;
 use std::path::Path;
 use std::time::Instant;
 
-/// The block shared by every case: 50 x 50 x 40 elements of 2.8 mm (the paper's voxel).
-const BLOCK: &str = r#"
+/// The block shared by every case: 50 x 50 x 40 elements of 2.8 mm (the paper's voxel), its
+/// nodes numbered `numbering`.
+fn block(numbering: Numbering) -> String {
+    format!(
+        r#"
 [mesh]
 generator = "box"
 origin = ["-70 mm", "-70 mm", "-112 mm"]
 size = ["140 mm", "140 mm", "112 mm"]
 divisions = [50, 50, 40]
 part = "body"
+numbering = "{}"
 
 [[boundary]]
 nodes = "zmin"
@@ -52,7 +56,10 @@ fix = ["all"]
 
 [output]
 vtk = false
-"#;
+"#,
+        numbering.label()
+    )
+}
 
 fn case_scene(case: &str, precision: Precision, numbering: Numbering) -> Result<String, String> {
     let nh = r#"
@@ -105,10 +112,7 @@ surface = "zmax"
             ))
         }
     };
-    let block = BLOCK.replace(
-        "part = \"body\"\n",
-        &format!("part = \"body\"\nnumbering = \"{}\"\n", numbering.label()),
-    );
+    let block = block(numbering);
     Ok(format!(
         "[run]\ntitle = \"bench {case}\"\nend_time = \"1 s\"\nprecision = \"{}\"\n{block}{body}",
         precision.label()

@@ -49,3 +49,25 @@ pub fn predict_stdin(model: &Path, lines: &[u8]) -> Output {
 pub fn s(p: &Path) -> &str {
     p.to_str().unwrap()
 }
+
+/// `palpa palpate` as a quick coarse press into `out`: 8 mm voxels, `depth_mm` in a time of the
+/// same number of ms, samples every 1 ms, no VTK, and the `extra` options (not yet run, so
+/// that a test may set its environment).
+pub fn coarse_press(out: &Path, depth_mm: u32, extra: &[&str]) -> Command {
+    let mut c = Command::new(env!("CARGO_BIN_EXE_palpa"));
+    c.arg("palpate")
+        .args(extra)
+        .args([
+            "--voxel",
+            "8mm",
+            "--sample-interval",
+            "1ms",
+            "--no-vtk",
+            "--quiet",
+        ])
+        .args(["--duration", &format!("{depth_mm}ms")])
+        .args(["--depth", &format!("{depth_mm}mm")])
+        .arg("--out")
+        .arg(out);
+    c
+}
