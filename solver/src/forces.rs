@@ -197,21 +197,37 @@ fn run_chunk<L: Law>(l: &L, b: &Batch, ci: usize) -> ChunkOut {
 }
 
 /// One chunk of batches with kernels over `R` (over `R::Avx512` with AVX-512), with the
-/// instruction set of [`simd_level`].
+/// instruction set of [`simd_level`]. The one-point and the fully integrated kernels are
+/// compiled as separate functions (`FULL`): in one function, adding work to one of them
+/// changed how the other was compiled (the F-bar block lost 7 % when the one-point kernel
+/// began to form its hourglass vectors).
 fn run_chunk_in<L: Law, R: KernelLanes>(l: &L, b: &Batch, ci: usize) -> ChunkOut {
+    let full = matches!(b.form, Formulation::Full { .. });
     #[cfg(target_arch = "x86_64")]
     if simd_level() == "avx512" {
         // SAFETY: the processor has the features (checked by `simd_level`).
-        return unsafe { run_chunk_avx512::<L, R::Avx512>(l, b, ci) };
+        return unsafe {
+            match full {
+                true => run_chunk_avx512::<L, R::Avx512, true>(l, b, ci),
+                false => run_chunk_avx512::<L, R::Avx512, false>(l, b, ci),
+            }
+        };
     }
-    run_chunk_body::<L, ScalarGather, R>(l, b, ci)
+    match full {
+        true => run_chunk_body::<L, ScalarGather, R, true>(l, b, ci),
+        false => run_chunk_body::<L, ScalarGather, R, false>(l, b, ci),
+    }
 }
 
 /// [`run_chunk_body`] compiled for AVX-512.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx512f,avx512dq,avx512vl,avx512bw")]
-unsafe fn run_chunk_avx512<L: Law, R: KernelLanes>(l: &L, b: &Batch, ci: usize) -> ChunkOut {
-    run_chunk_body::<L, Avx512Gather, R>(l, b, ci)
+unsafe fn run_chunk_avx512<L: Law, R: KernelLanes, const FULL: bool>(
+    l: &L,
+    b: &Batch,
+    ci: usize,
+) -> ChunkOut {
+    run_chunk_body::<L, Avx512Gather, R, FULL>(l, b, ci)
 }
 
 /// The number types the element kernels run in ([`F64x8`], [`F32x8`], and [`Z64x8`] in place
@@ -228,6 +244,13 @@ trait KernelLanes: Real {
     fn wide(x: F64x8) -> Self::Wide;
     /// A batch's stored history in the law's number type.
     fn history(h: &mut [F64x8]) -> &mut [Self::Wide];
+    /// Batch `bi`'s hourglass vectors ([`crate::hex::hourglass_vectors`]) from its reference
+    /// coordinates `x_ref`. In `f64` they are formed here, bitwise as the model formed them:
+    /// that costs about 300 vector operations per batch and saves reading 256 bytes per element
+    /// from memory (measured in docs/performance.md). In `f32` they are read.
+    fn hourglass_vectors(refs: &Refs<Self>, bi: usize, x_ref: &Nodal<F64x8>) -> [[Self; 8]; 4];
+    /// Whether [`KernelLanes::hourglass_vectors`] reads the stored vectors.
+    const READS_GAMMA: bool;
     /// Per-element `f64` lanes (volume, hourglass scale, density scale) in the kernel's type.
     #[inline(always)]
     fn per_element(x: F64x8) -> Self {
@@ -249,6 +272,11 @@ impl KernelLanes for F64x8 {
         *x
     }
     #[inline(always)]
+    fn hourglass_vectors(refs: &Refs<Self>, bi: usize, x_ref: &Nodal<F64x8>) -> [[Self; 8]; 4] {
+        crate::hex::hourglass_vectors(x_ref, &refs.grad[bi])
+    }
+    const READS_GAMMA: bool = false;
+    #[inline(always)]
     fn wide(x: F64x8) -> F64x8 {
         x
     }
@@ -269,6 +297,11 @@ impl KernelLanes for Z64x8 {
     fn nodal(x: &Nodal<F64x8>) -> Nodal<Self> {
         material::arr![3, |i| material::arr![8, |a| Self::wide(x[i][a])]]
     }
+    #[inline(always)]
+    fn hourglass_vectors(refs: &Refs<Self>, bi: usize, x_ref: &Nodal<F64x8>) -> [[Self; 8]; 4] {
+        crate::hex::hourglass_vectors(&Self::nodal(x_ref), &refs.grad[bi])
+    }
+    const READS_GAMMA: bool = false;
     #[inline(always)]
     fn wide(x: F64x8) -> Z64x8 {
         Z64x8::from_f64x8(x)
@@ -302,6 +335,11 @@ impl KernelLanes for F32x8 {
         }]
     }
     #[inline(always)]
+    fn hourglass_vectors(refs: &Refs<Self>, bi: usize, _: &Nodal<F64x8>) -> [[Self; 8]; 4] {
+        refs.gamma[bi]
+    }
+    const READS_GAMMA: bool = true;
+    #[inline(always)]
     fn wide(x: F64x8) -> F64x8 {
         x
     }
@@ -324,6 +362,11 @@ impl KernelLanes for Z32x8 {
         material::arr![3, |i| material::arr![8, |a| Z32x8(n[i][a])]]
     }
     #[inline(always)]
+    fn hourglass_vectors(refs: &Refs<Self>, bi: usize, _: &Nodal<F64x8>) -> [[Self; 8]; 4] {
+        refs.gamma[bi]
+    }
+    const READS_GAMMA: bool = true;
+    #[inline(always)]
     fn wide(x: F64x8) -> Z64x8 {
         Z64x8::from_f64x8(x)
     }
@@ -341,7 +384,11 @@ fn lanes_of(x: &[f64], le0: usize) -> F64x8 {
 }
 
 #[inline(always)]
-fn run_chunk_body<L: Law, G: GatherLanes, R: KernelLanes>(l: &L, b: &Batch, ci: usize) -> ChunkOut {
+fn run_chunk_body<L: Law, G: GatherLanes, R: KernelLanes, const FULL: bool>(
+    l: &L,
+    b: &Batch,
+    ci: usize,
+) -> ChunkOut {
     let g = b.group;
     let n = g.elements.len();
     let mut acc = ChunkOut {
@@ -361,17 +408,69 @@ fn run_chunk_body<L: Law, G: GatherLanes, R: KernelLanes>(l: &L, b: &Batch, ci: 
         } else {
             lanes_of(&g.density_scale, le0)
         };
-        let o = batch_forces::<L, G, R>(l, b, &refs, bi, &conn, s64, &mut fe);
+        if !FULL {
+            prefetch_batch(b, &refs, bi + PREFETCH_AHEAD);
+        }
+        let o = batch_forces::<L, G, R, FULL>(l, b, &refs, bi, &conn, s64, &mut fe);
         let add = book_lanes(l, b, le0, nvalid, &o, s64, &mut acc);
         scatter_forces(b, &conn, &add, &fe);
     }
     acc
 }
 
+/// How many batches ahead [`prefetch_batch`] asks for (one to four measured alike on the
+/// `palpa bench` blocks).
+const PREFETCH_AHEAD: usize = 2;
+
+/// Ask the cache for batch `bi`'s reference data and history, when the group has that batch.
+/// The kernels read each batch's data once per step from arrays of hundreds of bytes per
+/// element; the hardware prefetcher did not keep up with them, and the first loads of each
+/// batch stalled. Measured in docs/performance.md ("Reference data formed and fetched ahead").
+#[inline(always)]
+fn prefetch_batch<R: KernelLanes>(b: &Batch, refs: &Refs<R>, bi: usize) {
+    let g = b.group;
+    if bi >= g.batches() {
+        return;
+    }
+    if R::READS_GAMMA {
+        prefetch(refs.gamma.get(bi));
+    }
+    prefetch(refs.grad.get(bi));
+    prefetch(refs.hg_frame.get(bi));
+    prefetch(refs.hg_inv_len.get(bi));
+    prefetch(refs.gp_grad.get(bi));
+    prefetch(refs.gp_weight.get(bi));
+    let stride = g.history_stride;
+    // Pointer arithmetic only: other threads write other batches' history meanwhile.
+    let h = b.hist.0.wrapping_add(bi * stride) as *const u8;
+    prefetch_bytes(h, stride * std::mem::size_of::<F64x8>());
+}
+
+/// [`prefetch_bytes`] of one value, if there is one.
+#[inline(always)]
+fn prefetch<T>(x: Option<&T>) {
+    if let Some(x) = x {
+        prefetch_bytes(x as *const T as *const u8, std::mem::size_of::<T>());
+    }
+}
+
+/// Ask the cache for the `bytes` from `p`, line by line (a hint: it never faults).
+#[inline(always)]
+fn prefetch_bytes(p: *const u8, bytes: usize) {
+    #[cfg(target_arch = "x86_64")]
+    for k in (0..bytes).step_by(64) {
+        use std::arch::x86_64::{_mm_prefetch, _MM_HINT_T0};
+        // SAFETY: a prefetch does not access memory and never faults.
+        unsafe { _mm_prefetch::<_MM_HINT_T0>(p.wrapping_add(k) as *const i8) };
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    let _ = (p, bytes);
+}
+
 /// One batch's element kernel: the nodal data gathered into lanes (in `R`, see
 /// [`KernelLanes::nodal`]), the reference data and history of batch `bi`, the forces into `fe`.
 #[inline(always)]
-fn batch_forces<L: Law, G: GatherLanes, R: KernelLanes>(
+fn batch_forces<L: Law, G: GatherLanes, R: KernelLanes, const FULL: bool>(
     l: &L,
     b: &Batch,
     refs: &Refs<R>,
@@ -392,10 +491,11 @@ fn batch_forces<L: Law, G: GatherLanes, R: KernelLanes>(
     // SAFETY: batch bi owns history[bi*stride..(bi+1)*stride] alone.
     let h = R::history(unsafe { b.hist.slice(bi * stride, stride) });
     match b.form {
-        Formulation::OnePoint(hg) => {
+        Formulation::OnePoint(hg) if !FULL => {
+            let gamma = R::hourglass_vectors(refs, bi, &xr);
             let rf = one_point::OnePointRef {
                 grad: &refs.grad[bi],
-                gamma: &refs.gamma[bi],
+                gamma: &gamma,
                 vol0: R::per_element(lanes_of(&g.vol0, le0)),
                 hg_scale: R::per_element(lanes_of(&g.hg_scale, le0)),
                 physical: (!g.hg_frame.is_empty()).then(|| PhysicalRef {
@@ -408,7 +508,7 @@ fn batch_forces<L: Law, G: GatherLanes, R: KernelLanes>(
             };
             one_point::compute_forces(l, &rf, hg.form, &xe, &ue, &ve, s, b.input, h, fe)
         }
-        Formulation::Full { fbar } => {
+        Formulation::Full { fbar } if FULL => {
             let rf = full::FullRef {
                 centre_grad: &refs.grad[bi],
                 gp_grad: &refs.gp_grad[bi],
@@ -417,6 +517,7 @@ fn batch_forces<L: Law, G: GatherLanes, R: KernelLanes>(
             };
             full::compute_forces(l, &rf, fbar, &xe, &ue, &ve, s, b.input, h, fe)
         }
+        _ => unreachable!("run_chunk_in picks FULL from the formulation"),
     }
 }
 

@@ -12,6 +12,7 @@
 //! h_alpha the four modes xi*eta, eta*zeta, zeta*xi, xi*eta*zeta sampled at the corners.
 
 use crate::mesh::CORNERS;
+use material::real::Real;
 use nalgebra::{Matrix3, Vector3};
 
 /// Gauss point coordinate of the 2-point rule.
@@ -155,6 +156,7 @@ pub fn element_geometry(x: &[[f64; 3]; 8]) -> Result<ElementGeometry, (usize, f6
 }
 
 /// Hourglass base vectors h_alpha sampled at the corners.
+#[inline(always)]
 pub fn hourglass_modes() -> [[f64; 8]; 4] {
     let mut h = [[0.0; 8]; 4];
     for (a, c) in CORNERS.iter().enumerate() {
@@ -166,19 +168,38 @@ pub fn hourglass_modes() -> [[f64; 8]; 4] {
     h
 }
 
-/// Flanagan-Belytschko hourglass shape vectors gamma_alpha = h_alpha - (h_alpha . X_i) b_i.
+/// Flanagan-Belytschko hourglass shape vectors gamma_alpha = h_alpha - (h_alpha . X_i) b_i of
+/// one element, from its reference coordinates `x[a]` and mean gradient `b`.
 pub fn hourglass_gamma(x: &[[f64; 3]; 8], b: &[[f64; 8]; 3]) -> [[f64; 8]; 4] {
+    let xt: [[f64; 8]; 3] = material::arr![3, |i| material::arr![8, |a| x[a][i]]];
+    hourglass_vectors(&xt, b)
+}
+
+/// [`hourglass_gamma`] over lanes (one element per lane), from the reference coordinates
+/// `x[i][a]` and mean gradients `b[i][a]` in component-major order. The one-point kernels form
+/// their vectors here each step in `f64` (see `solver::forces`), the model builder once: the
+/// same operations in the same order, so both give the same bits (`h` is +-1, so `h x` is
+/// exact and each sum adds or subtracts the coordinates in node order).
+#[inline(always)]
+pub fn hourglass_vectors<R: Real>(x: &[[R; 8]; 3], b: &[[R; 8]; 3]) -> [[R; 8]; 4] {
+    // `material::arr!` and plain loops rather than closures: a closure does not inherit the
+    // AVX-512 kernels' target features, and its lane operations would not be inlined.
     let h = hourglass_modes();
-    let mut gamma = [[0.0; 8]; 4];
+    let mut gamma = [[R::zero(); 8]; 4];
     for al in 0..4 {
-        let mut hx = [0.0; 3];
-        for a in 0..8 {
-            for i in 0..3 {
-                hx[i] += h[al][a] * x[a][i];
+        let mut hx = [R::zero(); 3];
+        for i in 0..3 {
+            for a in 0..8 {
+                hx[i] = if h[al][a] > 0.0 {
+                    hx[i] + x[i][a]
+                } else {
+                    hx[i] - x[i][a]
+                };
             }
         }
         for a in 0..8 {
-            gamma[al][a] = h[al][a] - (hx[0] * b[0][a] + hx[1] * b[1][a] + hx[2] * b[2][a]);
+            gamma[al][a] =
+                R::splat(h[al][a]) - (hx[0] * b[0][a] + hx[1] * b[1][a] + hx[2] * b[2][a]);
         }
     }
     gamma
@@ -246,5 +267,38 @@ mod tests {
         x[6] = [0.2, 0.2, 0.2];
         x[6] = [-0.5, -0.5, -0.5];
         assert!(element_geometry(&x).is_err());
+    }
+
+    #[test]
+    fn hourglass_vectors_in_lanes_are_the_builders_bit_for_bit() {
+        // Eight differently skewed elements, one per lane: the kernels' lane form must give the
+        // very bits the model builder stored (the f64 kernels form them instead of reading).
+        use material::real::{F64x8, LANES};
+        let els: Vec<[[f64; 3]; 8]> = (0..LANES)
+            .map(|q| {
+                let mut x = skewed();
+                x[q][q % 3] += 0.013 * (q as f64 + 1.0);
+                x.iter_mut().for_each(|p| p[0] += 1234.5678 * q as f64);
+                x
+            })
+            .collect();
+        let geo: Vec<_> = els.iter().map(|x| element_geometry(x).unwrap()).collect();
+        let lanes = |f: &dyn Fn(usize, usize, usize) -> f64| -> [[F64x8; 8]; 3] {
+            material::arr![3, |i| material::arr![8, |a| F64x8::new(material::arr![
+                LANES,
+                |q| f(q, i, a)
+            ])]]
+        };
+        let x = lanes(&|q, i, a| els[q][a][i]);
+        let b = lanes(&|q, i, a| geo[q].mean_grad[i][a]);
+        let g = hourglass_vectors(&x, &b);
+        for q in 0..LANES {
+            let want = hourglass_gamma(&els[q], &geo[q].mean_grad);
+            for al in 0..4 {
+                for a in 0..8 {
+                    assert_eq!(g[al][a].to_array()[q].to_bits(), want[al][a].to_bits());
+                }
+            }
+        }
     }
 }
