@@ -7,7 +7,13 @@
 //! hourglass forces and the critical step of all eight ([`crate::element`], generic over
 //! [`material::real::Real`]). Reference data (gradients, hourglass vectors, Gauss-point data) and
 //! history are stored batch by batch in the same lane layout ([`crate::model::Group`]), so they
-//! load as whole vectors. The batch kernel is compiled twice: for AVX-512 (chosen at run time when
+//! load as whole vectors. Two measured exceptions to "read what was stored": the `f64` one-point
+//! kernels form their hourglass vectors from the reference coordinates they gather anyway
+//! ([`KernelLanes::hourglass_vectors`], bitwise the stored ones), and the one-point kernels ask
+//! the cache for the reference data and history two batches ahead ([`prefetch_batch`]). Both
+//! cut the stalls of the first loads of each batch; together they raised the one-point blocks
+//! of `palpa bench` 1.4-1.6x (docs/performance.md). Prefetching the fully integrated element's
+//! Gauss-point data made it slower, so it reads as before. The batch kernel is compiled twice: for AVX-512 (chosen at run time when
 //! the processor has it) and for the build's baseline (AVX2 with the project's `.cargo/config.toml`,
 //! SSE2 or NEON elsewhere). The AVX-512 path runs its own lane types (`Z64x8`, `Z32x8` of
 //! `material::real_avx512`: eight `f64` in one 512-bit register where `wide`'s `f64x8` is two
