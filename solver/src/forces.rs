@@ -13,7 +13,9 @@
 //! the cache for the reference data and history two batches ahead ([`prefetch_batch`]). Both
 //! cut the stalls of the first loads of each batch; together they raised the one-point blocks
 //! of `palpa bench` 1.4-1.6x (docs/performance.md). Prefetching the fully integrated element's
-//! Gauss-point data made it slower, so it reads as before. The batch kernel is compiled twice: for AVX-512 (chosen at run time when
+//! Gauss-point data made it slower, so it reads as before.
+//!
+//! The batch kernel is compiled twice: for AVX-512 (chosen at run time when
 //! the processor has it) and for the build's baseline (AVX2 with the project's `.cargo/config.toml`,
 //! SSE2 or NEON elsewhere). The AVX-512 path runs its own lane types (`Z64x8`, `Z32x8` of
 //! `material::real_avx512`: eight `f64` in one 512-bit register where `wide`'s `f64x8` is two
@@ -205,8 +207,9 @@ fn run_chunk<L: Law>(l: &L, b: &Batch, ci: usize) -> ChunkOut {
 /// One chunk of batches with kernels over `R` (over `R::Avx512` with AVX-512), with the
 /// instruction set of [`simd_level`]. The one-point and the fully integrated kernels are
 /// compiled as separate functions (`FULL`): in one function, adding work to one of them
-/// changed how the other was compiled (the F-bar block lost 7 % when the one-point kernel
-/// began to form its hourglass vectors).
+/// changed how the other was compiled. On the F-bar block (one thread) the shared function
+/// ran 2.86 M element-cycles/s once the one-point kernel formed its hourglass vectors, the
+/// separate one 3.01 M, the build before both 3.12-3.17 M (docs/performance.md).
 fn run_chunk_in<L: Law, R: KernelLanes>(l: &L, b: &Batch, ci: usize) -> ChunkOut {
     let full = matches!(b.form, Formulation::Full { .. });
     #[cfg(target_arch = "x86_64")]
@@ -254,8 +257,16 @@ trait KernelLanes: Real {
     /// coordinates `x_ref`. In `f64` they are formed here, bitwise as the model formed them:
     /// that costs about 300 vector operations per batch and saves reading 256 bytes per element
     /// from memory (measured in docs/performance.md). In `f32` they are read.
-    fn hourglass_vectors(refs: &Refs<Self>, bi: usize, x_ref: &Nodal<F64x8>) -> [[Self; 8]; 4];
-    /// Whether [`KernelLanes::hourglass_vectors`] reads the stored vectors.
+    #[inline(always)]
+    fn hourglass_vectors(refs: &Refs<Self>, bi: usize, x_ref: &Nodal<F64x8>) -> [[Self; 8]; 4] {
+        if Self::READS_GAMMA {
+            refs.gamma[bi]
+        } else {
+            crate::hex::hourglass_vectors(&Self::nodal(x_ref), &refs.grad[bi])
+        }
+    }
+    /// Whether [`KernelLanes::hourglass_vectors`] reads the stored vectors (`f32`) rather than
+    /// forming them (`f64`).
     const READS_GAMMA: bool;
     /// Per-element `f64` lanes (volume, hourglass scale, density scale) in the kernel's type.
     #[inline(always)]
@@ -276,10 +287,6 @@ impl KernelLanes for F64x8 {
     #[inline(always)]
     fn nodal(x: &Nodal<F64x8>) -> Nodal<Self> {
         *x
-    }
-    #[inline(always)]
-    fn hourglass_vectors(refs: &Refs<Self>, bi: usize, x_ref: &Nodal<F64x8>) -> [[Self; 8]; 4] {
-        crate::hex::hourglass_vectors(x_ref, &refs.grad[bi])
     }
     const READS_GAMMA: bool = false;
     #[inline(always)]
@@ -302,10 +309,6 @@ impl KernelLanes for Z64x8 {
     #[inline(always)]
     fn nodal(x: &Nodal<F64x8>) -> Nodal<Self> {
         material::arr![3, |i| material::arr![8, |a| Self::wide(x[i][a])]]
-    }
-    #[inline(always)]
-    fn hourglass_vectors(refs: &Refs<Self>, bi: usize, x_ref: &Nodal<F64x8>) -> [[Self; 8]; 4] {
-        crate::hex::hourglass_vectors(&Self::nodal(x_ref), &refs.grad[bi])
     }
     const READS_GAMMA: bool = false;
     #[inline(always)]
@@ -340,10 +343,6 @@ impl KernelLanes for F32x8 {
             material::arr![8, |a| F32x8::narrow(x[i][a] - x0)]
         }]
     }
-    #[inline(always)]
-    fn hourglass_vectors(refs: &Refs<Self>, bi: usize, _: &Nodal<F64x8>) -> [[Self; 8]; 4] {
-        refs.gamma[bi]
-    }
     const READS_GAMMA: bool = true;
     #[inline(always)]
     fn wide(x: F64x8) -> F64x8 {
@@ -366,10 +365,6 @@ impl KernelLanes for Z32x8 {
     fn nodal(x: &Nodal<F64x8>) -> Nodal<Self> {
         let n = F32x8::nodal(x);
         material::arr![3, |i| material::arr![8, |a| Z32x8(n[i][a])]]
-    }
-    #[inline(always)]
-    fn hourglass_vectors(refs: &Refs<Self>, bi: usize, _: &Nodal<F64x8>) -> [[Self; 8]; 4] {
-        refs.gamma[bi]
     }
     const READS_GAMMA: bool = true;
     #[inline(always)]
@@ -444,8 +439,6 @@ fn prefetch_batch<R: KernelLanes>(b: &Batch, refs: &Refs<R>, bi: usize) {
     prefetch(refs.grad.get(bi));
     prefetch(refs.hg_frame.get(bi));
     prefetch(refs.hg_inv_len.get(bi));
-    prefetch(refs.gp_grad.get(bi));
-    prefetch(refs.gp_weight.get(bi));
     let stride = g.history_stride;
     // Pointer arithmetic only: other threads write other batches' history meanwhile.
     let h = b.hist.0.wrapping_add(bi * stride) as *const u8;

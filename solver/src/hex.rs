@@ -182,7 +182,7 @@ pub fn hourglass_gamma(x: &[[f64; 3]; 8], b: &[[f64; 8]; 3]) -> [[f64; 8]; 4] {
 /// exact and each sum adds or subtracts the coordinates in node order).
 #[inline(always)]
 pub fn hourglass_vectors<R: Real>(x: &[[R; 8]; 3], b: &[[R; 8]; 3]) -> [[R; 8]; 4] {
-    // `material::arr!` and plain loops rather than closures: a closure does not inherit the
+    // Plain loops rather than closures (`std::array::from_fn`): a closure does not inherit the
     // AVX-512 kernels' target features, and its lane operations would not be inlined.
     let h = hourglass_modes();
     let mut gamma = [[R::zero(); 8]; 4];

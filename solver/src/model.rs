@@ -207,7 +207,9 @@ pub struct Group {
     pub grad: Vec<Nodal<F64x8>>,
     /// Reference volumes (m^3).
     pub vol0: Vec<f64>,
-    /// Hourglass vectors (one-point only), per batch.
+    /// Hourglass vectors (one-point only), per batch: read by the `f32` kernels (through
+    /// [`NarrowRef`]); the `f64` kernels form the same bits from the reference coordinates
+    /// (`solver::forces`).
     pub gamma: Vec<[[F64x8; 8]; 4]>,
     /// Hourglass scale per element (one-point only): a_s (N/m) for the stiffness form,
     /// Q rho0 V0^(2/3) / 4 (kg/m) for the viscous form, Q V0 / 3 (m^3) for the physical form.
@@ -297,7 +299,8 @@ impl Group {
         self.elements.len().div_ceil(LANES)
     }
 
-    /// The reference data the `f64` kernels read, borrowed.
+    /// The group's `f64` reference data, borrowed (the `f64` kernels read all but the
+    /// hourglass vectors: [`Group::kernel_bytes`]).
     pub fn refs(&self) -> Refs<'_, F64x8> {
         Refs {
             grad: &self.grad,
@@ -306,6 +309,16 @@ impl Group {
             hg_inv_len: &self.hg_inv_len,
             gp_grad: &self.gp_grad,
             gp_weight: &self.gp_weight,
+        }
+    }
+
+    /// Bytes of reference data the element kernels read per step: the `f32` copy when it
+    /// exists (an `f32` run), else the `f64` data less the hourglass vectors, which the `f64`
+    /// kernels form (`solver::forces`).
+    pub fn kernel_bytes(&self) -> usize {
+        match self.narrow.as_deref() {
+            Some(n) => n.refs().bytes(),
+            None => self.refs().bytes() - std::mem::size_of_val(self.gamma.as_slice()),
         }
     }
 

@@ -159,12 +159,7 @@ fn triad_bandwidth() -> f64 {
 fn step_bytes_per_element(m: &solver::model::Model) -> f64 {
     let mut bytes = 0usize;
     for g in &m.groups {
-        // An f32 run reads its reference data from the group's f32 copy; an f64 run forms its
-        // hourglass vectors instead of reading them (`solver::forces`).
-        let reference = match g.narrow.as_deref() {
-            Some(n) => n.refs().bytes(),
-            None => g.refs().bytes() - std::mem::size_of_val(g.refs().gamma),
-        };
+        let reference = g.kernel_bytes();
         bytes += g.conn.len() * (32 + 8 + 8)
             + reference
             + 2 * std::mem::size_of_val(g.history.as_slice())

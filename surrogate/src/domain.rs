@@ -9,6 +9,8 @@
 //!   [`HULL_TOLERANCE`] (a model interpolates between its locations; beyond them it
 //!   extrapolates);
 //! - the force exceeds the largest training force;
+//! - the respiratory phase (a model trained across phases) lies outside the trained phases'
+//!   range (a phase model interpolates between its phases; beyond them it extrapolates);
 //! - the GP's predictive deviation is large: more than [`DEVIATION_RATIO`] of its prior
 //!   deviation, `sigma(x) > 0.5 sigma_prior`, where `sigma(x)^2 = s_y^2 (sigma_f^2 -
 //!   k*^T K^-1 k*)` is the latent predictive variance and `sigma_prior = s_y sigma_f` what the
@@ -44,6 +46,10 @@ pub struct TrainingDomain {
     /// names one (`manifest.solver.force_filter_s`).
     #[serde(default)]
     pub force_filter_s: Option<f64>,
+    /// Smallest and largest training respiratory phase (0 exhalation .. 1 inspiration), for a
+    /// dataset with a `phase` column; absent otherwise (and in models saved before it).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub phase_range: Option<[f64; 2]>,
 }
 
 /// Why an input lies outside the training domain.
@@ -61,6 +67,13 @@ pub enum Outside {
         force_n: f64,
         /// The largest training force [N].
         max_n: f64,
+    },
+    /// The respiratory phase is outside the trained phases.
+    Phase {
+        /// The phase asked for.
+        phase: f64,
+        /// The smallest and largest trained phase.
+        range: [f64; 2],
     },
     /// The GP's predictive deviation is large.
     Deviation {
@@ -83,6 +96,11 @@ impl std::fmt::Display for Outside {
                 f,
                 "force {force_n:.1} N above the largest trained force ({max_n:.1} N)"
             ),
+            Outside::Phase { phase, range } => write!(
+                f,
+                "respiratory phase {phase:.2} outside the trained phases {:.2} .. {:.2}",
+                range[0], range[1]
+            ),
             Outside::Deviation { sd_pa, prior_pa } => write!(
                 f,
                 "large predictive deviation: {:.2} kPa ({:.0} % of the GP's prior {:.2} kPa)",
@@ -103,7 +121,12 @@ impl TrainingDomain {
         }
         let mut locations: Vec<[f64; 2]> = Vec::new();
         let (mut fmax, mut lo, mut hi) = (0.0f64, f64::INFINITY, f64::NEG_INFINITY);
+        let phase_col = data.manifest.x_columns.iter().position(|n| n == "phase");
+        let mut phases = [f64::INFINITY, f64::NEG_INFINITY];
         for &i in &rows {
+            if let Some(c) = phase_col {
+                phases = [phases[0].min(data.x[(i, c)]), phases[1].max(data.x[(i, c)])];
+            }
             let p = [data.x[(i, 0)], data.x[(i, 1)]];
             if !locations.contains(&p) {
                 locations.push(p);
@@ -120,7 +143,15 @@ impl TrainingDomain {
             force_max_n: fmax,
             stress_range_pa: [lo, hi],
             force_filter_s: data.manifest.solver["force_filter_s"].as_f64(),
+            phase_range: phase_col.map(|_| phases),
         })
+    }
+
+    /// Whether a respiratory `phase` lies outside the trained phases (never for a domain that
+    /// records none).
+    pub fn assess_phase(&self, phase: f64) -> Option<Outside> {
+        let range = self.phase_range?;
+        (!(range[0]..=range[1]).contains(&phase)).then_some(Outside::Phase { phase, range })
     }
 
     /// Distance [m] of (x, y) outside the training hull; 0 inside. A hull of fewer than three
@@ -217,5 +248,36 @@ mod tests {
             .contains("above the largest trained force"));
         assert!(flags[1].to_string().contains("60 %"), "{}", flags[1]);
         assert!(d.assess(0.05, 0.05, f, Some((400.0, 1000.0))).is_empty());
+    }
+
+    #[test]
+    fn phase_range_of_a_respiratory_dataset() {
+        // the synthetic dataset's time column read as trained phases 0.2 .. 0.6
+        let mut data = make_synthetic_dataset(4);
+        assert!(TrainingDomain::of_training_rows(&data)
+            .unwrap()
+            .phase_range
+            .is_none());
+        data.manifest.x_columns[3] = "phase".into();
+        for i in 0..data.x.nrows() {
+            data.x[(i, 3)] = 0.2 + 0.1 * (i % 5) as f64;
+        }
+        let d = TrainingDomain::of_training_rows(&data).unwrap();
+        let [lo, hi] = d.phase_range.unwrap();
+        assert!(
+            (lo - 0.2).abs() < 1e-15 && (hi - 0.6).abs() < 1e-15,
+            "{lo} {hi}"
+        );
+        assert_eq!(d.assess_phase(0.2), None);
+        assert_eq!(d.assess_phase(0.45), None);
+        let out = d.assess_phase(0.9).unwrap();
+        assert_eq!(
+            out.to_string(),
+            "respiratory phase 0.90 outside the trained phases 0.20 .. 0.60"
+        );
+        // recorded in model.json and read back
+        let js = serde_json::to_string(&d).unwrap();
+        assert!(js.contains("\"phase_range\""), "{js}");
+        assert_eq!(serde_json::from_str::<TrainingDomain>(&js).unwrap(), d);
     }
 }

@@ -31,6 +31,7 @@ impl Warning {
             Warning::Domain(Outside::Position { .. }) => "outside_training_locations",
             Warning::Domain(Outside::Force { .. }) => "force_above_training",
             Warning::Domain(Outside::Deviation { .. }) => "large_deviation",
+            Warning::Domain(Outside::Phase { .. }) => "phase_outside_training",
         }
     }
 }
@@ -114,7 +115,8 @@ impl ServedModel {
     }
 
     /// What lies outside the model's knowledge for a press at (x, y) with `force`, given the
-    /// (deviation, prior deviation) when the model has them.
+    /// (deviation, prior deviation) when the model has them, and, for a model with a phase
+    /// input, at the phase set on its predictor.
     pub fn assess(
         &self,
         x: f64,
@@ -134,6 +136,9 @@ impl ServedModel {
                     .into_iter()
                     .map(Warning::Domain),
             );
+            if self.predictor.takes_phase() {
+                w.extend(d.assess_phase(self.predictor.phase()).map(Warning::Domain));
+            }
         }
         w
     }
