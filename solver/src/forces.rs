@@ -103,6 +103,8 @@ struct Batch<'a> {
 /// Run the element loop: set `force` (one entry per node) to the sum of the element forces and
 /// `stress` (if requested, indexed by global element id) to the Cauchy stress; return totals or
 /// the first failing element.
+/// `x_ref` must be the coordinates the model was built from: the `f64` one-point kernels form
+/// their hourglass vectors from it.
 #[allow(clippy::too_many_arguments)]
 pub fn element_loop(
     parts: &[Part],
