@@ -31,6 +31,12 @@ pub struct Constraint {
     pub kind: Kinematic,
 }
 
+/// The prescription of the kinematic conditions that share one code in the nodal update.
+#[derive(Clone, Debug)]
+pub(crate) struct Prescribed {
+    pub(crate) kind: Kinematic,
+}
+
 /// A nodal force (N) applied to every node of a set, along one direction, scaled by a curve.
 #[derive(Clone, Debug)]
 pub struct NodalLoad {

@@ -52,6 +52,8 @@ use contact::{ContactStage, IndenterSpec};
 pub struct ContactForceStage {
     stage: ContactStage,
     faces: Vec<[u32; 4]>,
+    /// The nodes of `faces`, ascending: the only positions the stage reads.
+    face_nodes: Vec<u32>,
     /// Contact forces of the last evaluation (N), nonzero only on `nodes`.
     fc: Vec<[f64; 3]>,
     mark: Vec<bool>,
@@ -99,8 +101,12 @@ impl ContactForceStage {
                 columns.push(format!("{}_{c}", s.name));
             }
         }
+        let mut face_nodes: Vec<u32> = faces.iter().flatten().copied().collect();
+        face_nodes.sort_unstable();
+        face_nodes.dedup();
         ContactForceStage {
             stage,
+            face_nodes,
             faces,
             fc: vec![[0.0; 3]; n_nodes],
             mark: vec![false; n_nodes],
@@ -157,6 +163,10 @@ impl ForceStage for ContactForceStage {
             o[2] += f[2];
         }
         self.body_work += 0.5 * dtp * w;
+    }
+
+    fn nodes_read(&self) -> Option<&[u32]> {
+        Some(&self.face_nodes)
     }
 
     fn energy(&self) -> f64 {

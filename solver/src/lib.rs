@@ -13,6 +13,7 @@ pub mod hex;
 pub mod mesh;
 pub mod mesh_io;
 pub mod model;
+mod nodal_update;
 pub mod output;
 pub mod renumber;
 pub mod simulation;

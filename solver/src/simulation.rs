@@ -21,16 +21,14 @@
 //! Only the stages the scene asks for exist: damping, gravity, loads, contact and dynamic
 //! relaxation are `Option`s decided at construction.
 
-use crate::bc::{Constraint, Kinematic, NodalLoad};
+use crate::bc::{Constraint, Kinematic, NodalLoad, Prescribed};
 use crate::element::precision::Precision;
 use crate::element::{BulkViscosity, StepInput};
 use crate::forces::element_loop;
 use crate::model::{ElementTotals, Model, SolverError};
+use crate::nodal_update::{NodalUpdate, StepParams, StepSums, NODE_CHUNK};
 use rayon::prelude::*;
 use std::time::{Duration, Instant};
-
-/// Nodes per chunk of the parallel update (fixed, so sums are thread-count independent).
-const NODE_CHUNK: usize = 2048;
 
 /// Energies at the current time (J).
 #[derive(Clone, Copy, Debug, Default)]
@@ -120,6 +118,11 @@ pub trait ForceStage: Send {
     /// Add forces at time `t` for current positions `x` and velocities `v` (at the last half
     /// step) to `force`; `dt` is the step about to be taken.
     fn apply(&mut self, t: f64, dt: f64, x: &[[f64; 3]], v: &[[f64; 3]], force: &mut [[f64; 3]]);
+    /// The nodes whose current positions `apply` reads, or `None` for all of them. The solver
+    /// forms the positions `x` only at these nodes; `x` holds stale values elsewhere.
+    fn nodes_read(&self) -> Option<&[u32]> {
+        None
+    }
     /// Energy the stage has absorbed (J) (stored penalty energy plus dissipation).
     fn energy(&self) -> f64;
     /// Work the stage's forces have done on the body so far (J), by the solver's trapezoidal rule.
@@ -218,12 +221,6 @@ impl Default for LoopSettings {
     }
 }
 
-/// Prescribed degree of freedom.
-#[derive(Clone, Debug)]
-struct Prescribed {
-    kind: Kinematic,
-}
-
 /// The running simulation.
 pub struct Simulation {
     /// The model.
@@ -243,6 +240,9 @@ pub struct Simulation {
     /// Cauchy stress per element at the last output step (Pa), if requested.
     pub stress: Option<Vec<[f64; 6]>>,
     dof_code: Vec<u32>,
+    /// Per chunk of the nodal update: whether any of its degrees of freedom has a kinematic
+    /// condition.
+    constrained_chunks: Vec<bool>,
     prescribed: Vec<Prescribed>,
     loads: Vec<NodalLoad>,
     gravity_force: Option<Vec<[f64; 3]>>,
@@ -349,6 +349,10 @@ impl Simulation {
             } else {
                 None
             },
+            constrained_chunks: dof_code
+                .chunks(3 * NODE_CHUNK)
+                .map(|c| c.iter().any(|&k| k != 0))
+                .collect(),
             dof_code,
             prescribed,
             loads,
@@ -609,8 +613,15 @@ impl Simulation {
         let t = self.time;
         let t0 = Instant::now();
         match &self.gravity_force {
-            Some(g) => self.f_ext.copy_from_slice(g),
-            None => self.f_ext.iter_mut().for_each(|f| *f = [0.0; 3]),
+            Some(g) => self
+                .f_ext
+                .par_chunks_mut(4096)
+                .zip(g.par_chunks(4096))
+                .for_each(|(f, g)| f.copy_from_slice(g)),
+            None => self
+                .f_ext
+                .par_chunks_mut(4096)
+                .for_each(|f| f.fill([0.0; 3])),
         }
         for l in &self.loads {
             let val = l.curve.value(t);
@@ -622,10 +633,24 @@ impl Simulation {
         if !self.stages.is_empty() {
             let t0 = Instant::now();
             let nodes = &self.model.mesh.nodes;
-            // Current positions are formed by each stage from reference + displacement.
+            // Current positions, reference + displacement, where the stages read them (the
+            // contact stage: the nodes of its surface faces; measured in docs/performance.md).
             let cur: &mut Vec<[f64; 3]> = &mut self.scratch_x;
-            for (c, (p, d)) in cur.iter_mut().zip(nodes.iter().zip(self.u.iter())) {
+            let u = &self.u;
+            let at = |c: &mut [f64; 3], n: usize| {
+                let (p, d) = (nodes[n], u[n]);
                 *c = [p[0] + d[0], p[1] + d[1], p[2] + d[2]];
+            };
+            if self.stages.iter().all(|s| s.nodes_read().is_some()) {
+                for st in &self.stages {
+                    for &n in st.nodes_read().unwrap_or_default() {
+                        at(&mut cur[n as usize], n as usize);
+                    }
+                }
+            } else {
+                for (n, c) in cur.iter_mut().enumerate() {
+                    at(c, n);
+                }
             }
             for st in self.stages.iter_mut() {
                 st.apply(t, dt, cur, &self.v, &mut self.f_ext);
@@ -827,6 +852,7 @@ impl Simulation {
             f_int: &self.f_int,
             f_ext: &self.f_ext,
             dof_code: &self.dof_code,
+            constrained: &self.constrained_chunks,
             prescribed: &self.prescribed,
             targets: &self.scratch_targets,
         };
@@ -836,7 +862,7 @@ impl Simulation {
             .zip(self.reaction.par_chunks_mut(NODE_CHUNK))
             .zip(partials.par_iter_mut())
             .enumerate()
-            .for_each(|(ci, (((uc, vc), rc), s))| nodal.chunk(ci, uc, vc, rc, s));
+            .for_each(|(ci, (((uc, vc), rc), s))| *s = nodal.chunk(ci, uc, vc, rc));
         let mut s = StepSums::default();
         for p in partials.iter() {
             s.add(p);
@@ -996,160 +1022,4 @@ fn underwood_alpha(s: &StepSums, dt: f64) -> f64 {
         0.0
     };
     (2.0 * w2.sqrt()).min(1.0 / dt)
-}
-
-/// The scalars of one nodal update: the steps around t^n and the damping.
-#[derive(Clone, Copy, Debug)]
-struct StepParams {
-    /// The step dt^(n+1/2) about to be taken (s).
-    dt: f64,
-    /// The step dt^(n-1/2) taken last (s).
-    dt_old: f64,
-    /// Their mean, the step of the velocity update (s).
-    dt_avg: f64,
-    /// Mass-proportional damping coefficient (1/s).
-    alpha: f64,
-    /// Whether the damping force is applied.
-    damping: bool,
-    /// Dynamic relaxation: also sum `u.f_int` and `u.M.u`.
-    relax: bool,
-}
-
-/// The sums of the nodal update over one chunk of nodes or all of them: the work of the
-/// internal, external (loads, gravity, contact and constraint reactions) and damping forces
-/// over the half steps before and after t^n, the kinetic energies, and the norms of the
-/// residual and of the dynamic relaxation.
-#[derive(Clone, Copy, Debug, Default)]
-struct StepSums {
-    /// `f_int . dt_old/2 v^(n-1/2)`.
-    w_int_old: f64,
-    /// `f_int . dt/2 v^(n+1/2)`.
-    w_int_new: f64,
-    /// `(f_ext + R) . dt_old/2 v^(n-1/2)`.
-    w_ext_old: f64,
-    /// `(f_ext + R) . dt/2 v^(n+1/2)`.
-    w_ext_new: f64,
-    /// `f_damp . dt_old/2 v^(n-1/2)`.
-    w_damp_old: f64,
-    /// `f_damp . dt/2 v^(n+1/2)`.
-    w_damp_new: f64,
-    /// Kinetic energy at t^n, of `v^n = (v^(n-1/2) + v^(n+1/2)) / 2`.
-    kinetic: f64,
-    /// `|f_ext - f_int - f_damp|^2` over the free degrees of freedom.
-    residual2: f64,
-    /// `|f_int|^2`.
-    f_int2: f64,
-    /// `u . f_int` (dynamic relaxation only).
-    u_f_int: f64,
-    /// `u . M u` (dynamic relaxation only).
-    u_m_u: f64,
-}
-
-impl StepSums {
-    /// Add the sums of another chunk.
-    fn add(&mut self, o: &StepSums) {
-        self.w_int_old += o.w_int_old;
-        self.w_int_new += o.w_int_new;
-        self.w_ext_old += o.w_ext_old;
-        self.w_ext_new += o.w_ext_new;
-        self.w_damp_old += o.w_damp_old;
-        self.w_damp_new += o.w_damp_new;
-        self.kinetic += o.kinetic;
-        self.residual2 += o.residual2;
-        self.f_int2 += o.f_int2;
-        self.u_f_int += o.u_f_int;
-        self.u_m_u += o.u_m_u;
-    }
-}
-
-/// What the nodal update reads, shared by its parallel chunks.
-struct NodalUpdate<'a> {
-    p: StepParams,
-    mass: &'a [f64],
-    f_int: &'a [[f64; 3]],
-    f_ext: &'a [[f64; 3]],
-    dof_code: &'a [u32],
-    prescribed: &'a [Prescribed],
-    /// Each prescription's target this step (see [`Simulation::kinematic_targets`]).
-    targets: &'a [f64],
-}
-
-impl NodalUpdate<'_> {
-    /// Update the nodes of chunk `ci` (their displacements `uc`, velocities `vc` and reactions
-    /// `rc`), node by node and direction by direction, adding to the chunk's sums `s`.
-    fn chunk(
-        &self,
-        ci: usize,
-        uc: &mut [[f64; 3]],
-        vc: &mut [[f64; 3]],
-        rc: &mut [[f64; 3]],
-        s: &mut StepSums,
-    ) {
-        for k in 0..uc.len() {
-            let n = ci * NODE_CHUNK + k;
-            let m = self.mass[n];
-            for d in 0..3 {
-                rc[k][d] = self.dof(n, d, m, &mut uc[k][d], &mut vc[k][d], s);
-            }
-        }
-    }
-
-    /// Direction `d` of node `n` (mass `m`): the new velocity `v` (from the net force, or
-    /// imposed by a kinematic condition) and displacement `u`, and the sums; returns the
-    /// reaction of the kinematic condition (0 on a free degree of freedom).
-    #[inline]
-    fn dof(&self, n: usize, d: usize, m: f64, u: &mut f64, v: &mut f64, s: &mut StepSums) -> f64 {
-        let p = &self.p;
-        let v_old = *v;
-        let fi = self.f_int[n][d];
-        let fe = self.f_ext[n][d];
-        let fd = if p.damping { p.alpha * m * v_old } else { 0.0 };
-        let fnet = fe - fi - fd;
-        let code = self.dof_code[n * 3 + d];
-        let (v_new, r) = if code == 0 {
-            (v_old + p.dt_avg * fnet / m, 0.0)
-        } else {
-            let v_new = self.imposed_velocity(code, *u);
-            (v_new, m * (v_new - v_old) / p.dt_avg - fnet)
-        };
-        if code == 0 {
-            s.residual2 += fnet * fnet;
-        }
-        s.f_int2 += fi * fi;
-        if p.relax {
-            let u_n = *u;
-            s.u_f_int += u_n * fi;
-            s.u_m_u += m * u_n * u_n;
-        }
-        let h_old = 0.5 * p.dt_old * v_old;
-        let h_new = 0.5 * p.dt * v_new;
-        s.w_int_old += fi * h_old;
-        s.w_int_new += fi * h_new;
-        s.w_ext_old += (fe + r) * h_old;
-        s.w_ext_new += (fe + r) * h_new;
-        s.w_damp_old += fd * h_old;
-        s.w_damp_new += fd * h_new;
-        let vn = 0.5 * (v_old + v_new);
-        s.kinetic += 0.5 * m * vn * vn;
-        *v = v_new;
-        *u += p.dt * v_new;
-        r
-    }
-
-    /// The velocity v^(n+1/2) the kinematic condition `code` (1 fixed, k + 2 the k-th
-    /// prescription) imposes on a degree of freedom at displacement `u`: zero, the prescribed
-    /// velocity, or the velocity that lands on the prescribed displacement.
-    #[inline]
-    fn imposed_velocity(&self, code: u32, u: f64) -> f64 {
-        match code {
-            1 => 0.0,
-            c => {
-                let tgt = self.targets[(c - 2) as usize];
-                match self.prescribed[(c - 2) as usize].kind {
-                    Kinematic::Displacement(_) => (tgt - u) / self.p.dt,
-                    _ => tgt,
-                }
-            }
-        }
-    }
 }
