@@ -758,6 +758,12 @@ impl ContactStage {
         self.rebuilds += 1;
     }
 
+    /// The surface faces (node ids): the only nodes whose positions [`ContactStage::apply`]
+    /// reads.
+    pub fn faces(&self) -> &[[u32; 4]] {
+        &self.faces
+    }
+
     /// Per-indenter results of the last [`ContactStage::apply`].
     pub fn indenters(&self) -> &[IndenterState] {
         &self.states

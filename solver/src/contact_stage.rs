@@ -52,7 +52,7 @@ use contact::{ContactStage, IndenterSpec};
 pub struct ContactForceStage {
     stage: ContactStage,
     faces: Vec<[u32; 4]>,
-    /// The nodes of `faces`, ascending: the only positions the stage reads.
+    /// The nodes of the stage's faces, ascending: the only positions it reads.
     face_nodes: Vec<u32>,
     /// Contact forces of the last evaluation (N), nonzero only on `nodes`.
     fc: Vec<[f64; 3]>,
@@ -101,7 +101,9 @@ impl ContactForceStage {
                 columns.push(format!("{}_{c}", s.name));
             }
         }
-        let mut face_nodes: Vec<u32> = faces.iter().flatten().copied().collect();
+        // The positions the stage reads: its own faces' nodes (the stage's, not `faces`, so
+        // that they cannot differ).
+        let mut face_nodes: Vec<u32> = stage.faces().iter().flatten().copied().collect();
         face_nodes.sort_unstable();
         face_nodes.dedup();
         ContactForceStage {

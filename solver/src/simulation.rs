@@ -26,9 +26,12 @@ use crate::element::precision::Precision;
 use crate::element::{BulkViscosity, StepInput};
 use crate::forces::element_loop;
 use crate::model::{ElementTotals, Model, SolverError};
-use crate::nodal_update::{NodalUpdate, StepParams, StepSums, NODE_CHUNK};
+use crate::nodal_update::{constrained_chunks, NodalUpdate, StepParams, StepSums, NODE_CHUNK};
 use rayon::prelude::*;
 use std::time::{Duration, Instant};
+
+/// Nodes per parallel chunk when the external forces are cleared or set to gravity.
+const FILL_CHUNK: usize = 4096;
 
 /// Energies at the current time (J).
 #[derive(Clone, Copy, Debug, Default)]
@@ -235,7 +238,7 @@ pub struct Simulation {
     pub f_int: Vec<[f64; 3]>,
     /// External forces f_ext^n (N): loads, gravity, contact.
     pub f_ext: Vec<[f64; 3]>,
-    /// Constraint reactions R^n (N), on constrained dofs.
+    /// Constraint reactions R^n (N), on constrained dofs (written only there; zero elsewhere).
     pub reaction: Vec<[f64; 3]>,
     /// Cauchy stress per element at the last output step (Pa), if requested.
     pub stress: Option<Vec<[f64; 6]>>,
@@ -349,10 +352,7 @@ impl Simulation {
             } else {
                 None
             },
-            constrained_chunks: dof_code
-                .chunks(3 * NODE_CHUNK)
-                .map(|c| c.iter().any(|&k| k != 0))
-                .collect(),
+            constrained_chunks: constrained_chunks(&dof_code),
             dof_code,
             prescribed,
             loads,
@@ -615,12 +615,12 @@ impl Simulation {
         match &self.gravity_force {
             Some(g) => self
                 .f_ext
-                .par_chunks_mut(4096)
-                .zip(g.par_chunks(4096))
+                .par_chunks_mut(FILL_CHUNK)
+                .zip(g.par_chunks(FILL_CHUNK))
                 .for_each(|(f, g)| f.copy_from_slice(g)),
             None => self
                 .f_ext
-                .par_chunks_mut(4096)
+                .par_chunks_mut(FILL_CHUNK)
                 .for_each(|f| f.fill([0.0; 3])),
         }
         for l in &self.loads {
