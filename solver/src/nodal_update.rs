@@ -184,6 +184,8 @@ impl NodalUpdate<'_> {
         }
     }
 
+    /// [`Self::chunk`] with the damping force (`DAMP`) and the relaxation sums (`RELAX`)
+    /// decided at compile time.
     fn chunk_in<const DAMP: bool, const RELAX: bool>(
         &self,
         ci: usize,
