@@ -160,10 +160,10 @@ pub(crate) struct NodalUpdate<'a> {
 }
 
 /// One lane group of degrees of freedom: `LANES` values of each nodal field.
-struct Dofs<T> {
-    m: T,
-    fi: T,
-    fe: T,
+struct Dofs {
+    m: F64x8,
+    fi: F64x8,
+    fe: F64x8,
 }
 
 impl NodalUpdate<'_> {
@@ -185,7 +185,9 @@ impl NodalUpdate<'_> {
     }
 
     /// [`Self::chunk`] with the damping force (`DAMP`) and the relaxation sums (`RELAX`)
-    /// decided at compile time.
+    /// decided at compile time. (Read at run time, with `free` and `mixed` folded into one
+    /// function, the update of the 5 mm palpation took 1.89-2.16 s against 1.66-1.75 s, in
+    /// alternating runs: the constrained path stays out of line in [`Self::mixed`].)
     fn chunk_in<const DAMP: bool, const RELAX: bool>(
         &self,
         ci: usize,
@@ -295,7 +297,7 @@ impl NodalUpdate<'_> {
     #[inline(always)]
     fn free<const DAMP: bool, const RELAX: bool>(
         &self,
-        d: &Dofs<F64x8>,
+        d: &Dofs,
         u: &mut F64x8,
         v: &mut F64x8,
         s: &mut StepSums<F64x8>,
@@ -315,7 +317,7 @@ impl NodalUpdate<'_> {
     #[inline(never)]
     fn mixed<const DAMP: bool, const RELAX: bool>(
         &self,
-        d: &Dofs<F64x8>,
+        d: &Dofs,
         codes: &[u32],
         u: &mut F64x8,
         v: &mut F64x8,
@@ -349,7 +351,7 @@ impl NodalUpdate<'_> {
 
     /// The damping force (zero without `DAMP`) and the net force `f_ext - f_int - f_damp`.
     #[inline(always)]
-    fn net_force<const DAMP: bool>(&self, d: &Dofs<F64x8>, v_old: F64x8) -> (F64x8, F64x8) {
+    fn net_force<const DAMP: bool>(&self, d: &Dofs, v_old: F64x8) -> (F64x8, F64x8) {
         let fd = if DAMP {
             F64x8::splat(self.p.alpha) * d.m * v_old
         } else {
@@ -391,7 +393,7 @@ struct Block<'a> {
 #[inline(always)]
 fn sums<const RELAX: bool>(
     p: &StepParams,
-    d: &Dofs<F64x8>,
+    d: &Dofs,
     fd: F64x8,
     fe_r: F64x8,
     u: F64x8,
@@ -399,16 +401,15 @@ fn sums<const RELAX: bool>(
     v_new: F64x8,
     s: &mut StepSums<F64x8>,
 ) {
-    type T = F64x8;
     let fi = d.fi;
     s.f_int2 += fi * fi;
     if RELAX {
         s.u_f_int += u * fi;
         s.u_m_u += d.m * u * u;
     }
-    let half = T::splat(0.5);
-    let h_old = T::splat(0.5 * p.dt_old) * v_old;
-    let h_new = T::splat(0.5 * p.dt) * v_new;
+    let half = F64x8::splat(0.5);
+    let h_old = F64x8::splat(0.5 * p.dt_old) * v_old;
+    let h_new = F64x8::splat(0.5 * p.dt) * v_new;
     s.w_int_old += fi * h_old;
     s.w_int_new += fi * h_new;
     s.w_ext_old += fe_r * h_old;
