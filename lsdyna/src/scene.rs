@@ -1171,6 +1171,8 @@ fn build(cx: &mut Ctx, path: &Path) -> Result<SceneDef, Vec<String>> {
             dt_max,
             dt_min,
             max_steps: None,
+            // *CONTROL_SUBCYCLING is not read: decks run without subcycling
+            subcycling: 1,
             hourglass_guard,
             bulk,
             damping,

@@ -4,7 +4,7 @@ use super::contact_spec::HandScene;
 use super::def::{DtMin, Scene, SceneDef, Setup};
 use super::kinematics;
 use super::locate::Locate;
-use super::loop_settings::{max_steps, run_control, settings};
+use super::loop_settings::{max_steps, run_control, settings, subcycling};
 use super::node_sets::add_node_sets;
 use super::output_plan::output_plan;
 use super::parts::part_defs;
@@ -264,6 +264,14 @@ pub fn resolve_scene(
     let initial_velocity = kinematics::initial_velocities(&spec, &mesh, at)?;
     let output = output_plan(&spec.output, end_time, &mesh, at)?;
     let st = settings(&spec, at)?;
+    let subcycling = subcycling(&spec.run, at)?;
+    if subcycling > 1 && st.relaxation.is_some() {
+        return Err(at.err(
+            "run.subcycling",
+            Some("subcycling"),
+            &"cannot be combined with [relaxation] (its damping is formed from every node's force at every step)",
+        ));
+    }
     // Contact exists only when the scene has indenters or hands.
     let contact = if !spec.indenters.is_empty() || !spec.hands.is_empty() {
         Some(crate::contact_build::resolve_contact(
@@ -287,6 +295,7 @@ pub fn resolve_scene(
         dt_max: spec.run.dt_max.map(|t| t.0),
         dt_min: spec.run.dt_min.map(|t| DtMin::Time(t.0)),
         max_steps: max_steps(&spec.run, at)?,
+        subcycling,
         hourglass_guard: st.hourglass_guard,
         bulk: st.bulk,
         damping: st.damping,

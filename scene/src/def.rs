@@ -71,6 +71,8 @@ pub struct Setup {
     pub dt_factor: f64,
     /// The element kernels' number type.
     pub precision: Precision,
+    /// Subcycling's largest macro ratio (1: off).
+    pub subcycling: u32,
     /// Largest step (s).
     pub dt_max: Option<f64>,
     /// Smallest step before the run stops (default: 1e-6 of the initial step).
@@ -248,6 +250,7 @@ pub fn assemble(def: SceneDef) -> Result<Scene, String> {
             ratio: g.ratio,
             after: g.after.unwrap_or(0.1 * end_time),
         }),
+        subcycling: setup.subcycling,
     };
     let v0 = if setup.initial_velocity.is_empty() {
         None

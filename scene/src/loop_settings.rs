@@ -122,6 +122,24 @@ pub(crate) fn settings(spec: &SceneSpec, at: Locate) -> Result<Settings, String>
 }
 
 /// `[run] max_steps`, checked.
+/// `[run] subcycling`: the most steps a slow part's interior may take as one (a power of two
+/// from 1, off, to 1024; [`solver::subcycle`]).
+pub(crate) fn subcycling(run: &RunSpec, at: Locate) -> Result<u32, String> {
+    match run.subcycling.map(|x| x.0) {
+        None => Ok(1),
+        Some(k)
+            if (1.0..=1024.0).contains(&k) && k.fract() == 0.0 && (k as u32).is_power_of_two() =>
+        {
+            Ok(k as u32)
+        }
+        Some(k) => Err(at.err(
+            "run.subcycling",
+            Some("subcycling"),
+            &format!("must be a power of two from 1 (off) to 1024, got {k}"),
+        )),
+    }
+}
+
 pub(crate) fn max_steps(run: &RunSpec, at: Locate) -> Result<Option<f64>, String> {
     Ok(match run.max_steps.map(|x| x.0) {
         None => None,

@@ -240,6 +240,8 @@ pub struct PalpationSetup {
     pub fidelity: Fidelity,
     /// The element kernels' number type (`[run] precision`).
     pub precision: solver::element::precision::Precision,
+    /// Subcycling's largest macro ratio (`[run] subcycling`, [`solver::subcycle`]); 1 is off.
+    pub subcycling: u32,
     /// Write VTK frames.
     pub vtk: bool,
 }
@@ -268,6 +270,7 @@ impl Default for PalpationSetup {
             max_bulk_ratio: None,
             fidelity: Fidelity::Standard,
             precision: Default::default(),
+            subcycling: 1,
             vtk: true,
         }
     }

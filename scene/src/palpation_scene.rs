@@ -202,6 +202,7 @@ impl PalpationSetup {
                 max_hourglass_ratio: None,
                 hourglass_check_after: None,
                 max_steps: None,
+                subcycling: (self.subcycling > 1).then_some(Number(self.subcycling as f64)),
                 title: Some(self.title.clone()),
             },
             mesh: MeshSpec {
@@ -266,6 +267,11 @@ impl PalpationSetup {
             toml_num(self.dt_factor),
             self.precision.label()
         );
+        if self.subcycling > 1 {
+            // inside [run]: the blank line above ends the table only in looks
+            s.pop();
+            let _ = writeln!(s, "subcycling = {}\n", self.subcycling);
+        }
         self.write_mesh(&mut s);
         self.write_parts(&mut s);
         s.push_str("[[boundary]]\nnodes = \"back\"\nfix = [\"all\"]\n\n");
@@ -447,7 +453,7 @@ mod tests {
 
     /// The scene file of a setup parses to the scene the solver runs, for every kind of
     /// setting: places, tumours, per-part elements, mass scaling on and off, the K/G cap,
-    /// precision, the full phantom.
+    /// precision, subcycling, the full phantom.
     #[test]
     fn the_scene_file_parses_to_the_scene_built_in_memory() {
         let mut setups = vec![PalpationSetup::default()];
@@ -487,6 +493,10 @@ mod tests {
         };
         Fidelity::Fast.apply(&mut fast);
         setups.push(fast);
+        setups.push(PalpationSetup {
+            subcycling: 16,
+            ..Default::default()
+        });
         for e in ElementChoice::ALL {
             setups.push(PalpationSetup {
                 element: e,

@@ -157,6 +157,22 @@ pub struct RunSummary {
     /// The first eroded element.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub first_eroded: Option<ErodedElement>,
+    /// Subcycling, when the run had slow elements ([`solver::subcycle`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub subcycling: Option<SubcyclingReport>,
+}
+
+/// What subcycling did in a run.
+#[derive(Clone, Debug, Serialize)]
+pub struct SubcyclingReport {
+    /// Steps per macro step.
+    pub ratio: u32,
+    /// Per split part: its name, its slow elements and all its elements.
+    pub parts: Vec<(String, usize, usize)>,
+    /// Slow nodes.
+    pub slow_nodes: usize,
+    /// Element evaluations the run skipped, as a fraction of elements x steps.
+    pub saved_fraction: f64,
 }
 
 impl RunSummary {
@@ -695,6 +711,13 @@ fn summarise(scene: &Scene, wall: f64, status: RunStatus, rec: &Recorder) -> Run
         wall_seconds: wall,
         element_cycles_per_second: sim.model.mesh.elements.len() as f64 * sim.step as f64
             / wall.max(1e-12),
+        subcycling: sim.subcycling.as_ref().map(|s| SubcyclingReport {
+            ratio: s.k,
+            parts: s.parts.clone(),
+            slow_nodes: s.slow_nodes.len(),
+            saved_fraction: s.saved as f64
+                / (sim.model.mesh.elements.len() as f64 * sim.step.max(1) as f64),
+        }),
         dt_min: sim.dt_range.0,
         dt_max: sim.dt_range.1,
         energy_error: e.error(),

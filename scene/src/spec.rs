@@ -81,6 +81,10 @@ pub struct RunSpec {
     /// The most time steps the run may take by the estimate from the stable step (default
     /// [`crate::def::DEFAULT_MAX_STEPS`]); a scene that would take more is refused.
     pub max_steps: Option<Number>,
+    /// Subcycling: the most steps the interior of a part with a long stable step (the liver
+    /// beside the flesh) may take as one; a power of two, 1 (default) is off
+    /// ([`solver::subcycle`]).
+    pub subcycling: Option<Number>,
     /// A title.
     pub title: Option<String>,
 }

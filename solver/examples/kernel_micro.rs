@@ -48,6 +48,7 @@ macro_rules! run {
             bulk: Some(Default::default()),
             want_stress: false,
             precision: Default::default(),
+            macro_dt: None,
         };
         let mut h = vec![<<$R as Real>::Wide>::zero(); 64];
         let mut fe: Nodal<$R> = [[<$R>::zero(); 8]; 3];

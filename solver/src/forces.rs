@@ -36,6 +36,11 @@
 //! were cache misses 512 bytes apart). Chunk partial results (minimum step, energy rates: one
 //! [`ElementTotals`] per chunk) are reduced serially in chunk order, and inside a chunk element
 //! by element in element order, both by [`ElementTotals::combine`], for the same reason.
+//!
+//! Subcycling ([`crate::subcycle`]): a group of slow elements (`Group::subcycle` > 1) is
+//! evaluated only when [`StepInput::macro_dt`] is given, with that step for its laws; in the
+//! other steps it adds nothing to the nodal forces and reports the totals of its last
+//! evaluation ([`Group::held`]), its law dissipation only once.
 
 use crate::element::physical::PhysicalRef;
 use crate::element::precision::{NarrowRef, Precision, Refs};
@@ -139,6 +144,18 @@ pub fn element_loop(
     let force_ptr = Shared(force.as_mut_ptr());
     let mut tot = ElementTotals::EMPTY;
     for g in groups.iter_mut() {
+        // A subcycled group (crate::subcycle) is evaluated at macro times only, with the macro
+        // step; between them it reports the totals of its last evaluation.
+        let input = &match (g.subcycle, input.macro_dt) {
+            (1, _) => *input,
+            (_, Some(big)) => StepInput { dt: big, ..*input },
+            (_, None) => {
+                g.evaluated = false;
+                tot.combine(&g.held);
+                continue;
+            }
+        };
+        g.evaluated = true;
         let part = &parts[g.part];
         let n = g.elements.len();
         if input.precision == Precision::F32 && g.narrow.is_none() {
@@ -186,7 +203,7 @@ pub fn element_loop(
                 g.eroded[le as usize] = true;
             }
             let c = ElementTotals {
-                dt_min: ch.totals.dt_min * g.dt_kappa,
+                dt_min: ch.totals.dt_min * g.dt_kappa / g.subcycle as f64,
                 ..ch.totals
             };
             tot.combine(&c);
@@ -194,6 +211,15 @@ pub fn element_loop(
         }
         g.hourglass.stored = group.hg_stored;
         g.hourglass.power = group.hg_power;
+        if g.subcycle > 1 {
+            // the law dissipation covered the macro step: booked once, at this evaluation
+            g.held = ElementTotals {
+                law_dissipation: 0.0,
+                newly_eroded: 0,
+                first_eroded: None,
+                ..group
+            };
+        }
     }
     Ok(tot)
 }

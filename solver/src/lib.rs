@@ -17,6 +17,7 @@ mod nodal_update;
 pub mod output;
 pub mod renumber;
 pub mod simulation;
+pub mod subcycle;
 
 pub use mesh::Mesh;
 pub use model::{Model, Part, SolverError};

@@ -255,6 +255,14 @@ pub struct Group {
     pub dt_floor: f64,
     /// Lumped volume of each element node (m^3), kept only with mass scaling (to add mass).
     pub lumped: Vec<[f64; 8]>,
+    /// Steps per force evaluation: 1, or the macro ratio `k` of a subcycled run's slow
+    /// elements ([`crate::subcycle`]).
+    pub subcycle: u32,
+    /// A subcycled group's totals from its last evaluation, reported in the steps between
+    /// (its law dissipation only once).
+    pub held: ElementTotals,
+    /// Whether the last element loop evaluated this group (its chunks' results are new).
+    pub evaluated: bool,
     /// The group's hourglass energy, for the summary's warning that names the part.
     pub hourglass: GroupHourglass,
     /// The reference data in `f32` lanes, built the first time an `f32` run evaluates the
@@ -543,6 +551,11 @@ pub struct Model {
     /// step falls below it (LS-DYNA's negative DT2MS), see
     /// [`crate::simulation::Simulation`].
     pub mass_scaling: Option<ResolvedMassScaling>,
+    /// Smallest initial step `kappa L / c` of each part, with mass scaling (s; infinite for a
+    /// part without elements).
+    pub part_dt: Vec<f64>,
+    /// The time-step factor the model was built with.
+    dt_factor: f64,
 }
 
 /// Initial critical step of one element (s): L / c with L = V / A_max.
@@ -620,6 +633,7 @@ impl Model {
                 .collect(),
             initial_dt: (f64::INFINITY, 0u32),
             scaled_dt: f64::INFINITY,
+            part_dt: vec![f64::INFINITY; parts.len()],
         };
         let mut groups = Vec::new();
         for (pi, part) in parts.iter().enumerate() {
@@ -641,6 +655,7 @@ impl Model {
             part_mass,
             initial_dt,
             scaled_dt,
+            part_dt,
             ..
         } = builder;
         if let Some(ms) = mass_scaling {
@@ -659,6 +674,8 @@ impl Model {
             part_mass,
             initial_dt,
             scaled_dt,
+            part_dt,
+            dt_factor,
             mass_scaling: match (mass_scaling, fixed_target) {
                 (Some(m), Some(t)) => Some(ResolvedMassScaling {
                     target_dt: t,
@@ -667,6 +684,48 @@ impl Model {
                 _ => None,
             },
         })
+    }
+
+    /// Split every group with slow elements (`slow`, per global element id) into the group of
+    /// its other elements and a group of the slow ones evaluated every `k` steps
+    /// ([`crate::subcycle`]). Call before the first force evaluation: the groups are built
+    /// anew, with initial history. Returns, per split part, its name and how many of its
+    /// elements are slow out of how many.
+    pub fn split_for_subcycling(
+        &mut self,
+        slow: &[bool],
+        k: u32,
+    ) -> Result<Vec<(String, usize, usize)>, SolverError> {
+        let mut builder = Builder {
+            mesh: &self.mesh,
+            dt_factor: self.dt_factor,
+            target: self.mass_scaling.map(|m| m.target_dt),
+            scaling: self.mass_scaling.is_some(),
+            mass: vec![0.0; self.mesh.nodes.len()],
+            part_mass: vec![PartMass::default(); self.parts.len()],
+            initial_dt: (f64::INFINITY, 0u32),
+            scaled_dt: f64::INFINITY,
+            part_dt: vec![f64::INFINITY; self.parts.len()],
+        };
+        let mut groups = Vec::with_capacity(self.groups.len() + 1);
+        let mut split = Vec::new();
+        for g in std::mem::take(&mut self.groups) {
+            let (s, f): (Vec<u32>, Vec<u32>) = g.elements.iter().partition(|&&e| slow[e as usize]);
+            if s.is_empty() {
+                groups.push(g);
+                continue;
+            }
+            let part = &self.parts[g.part];
+            split.push((part.name.clone(), s.len(), g.elements.len()));
+            if !f.is_empty() {
+                groups.push(builder.group(g.part, part, f)?);
+            }
+            let mut sg = builder.group(g.part, part, s)?;
+            sg.subcycle = k;
+            groups.push(sg);
+        }
+        self.groups = groups;
+        Ok(split)
     }
 
     /// Total physical mass (kg).
@@ -735,6 +794,8 @@ struct Builder<'m> {
     initial_dt: (f64, u32),
     /// Smallest initial step with mass scaling (s).
     scaled_dt: f64,
+    /// The same per part (s).
+    part_dt: Vec<f64>,
 }
 
 /// The constants of one part that its elements' reference data and steps need.
@@ -844,6 +905,7 @@ impl Builder<'_> {
             }
         }
         self.scaled_dt = self.scaled_dt.min(dte * s.sqrt());
+        self.part_dt[pi] = self.part_dt[pi].min(dte * s.sqrt());
         data.scale.push(s);
         if self.scaling {
             g.lumped.push(geo.lumped_volume);
@@ -889,6 +951,9 @@ fn empty_group(part: usize, elements: Vec<u32>, stride: usize) -> Group {
         dt_kappa: 1.0,
         dt_floor: 0.0,
         lumped: Vec::new(),
+        subcycle: 1,
+        held: ElementTotals::EMPTY,
+        evaluated: false,
     }
 }
 

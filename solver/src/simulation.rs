@@ -27,6 +27,7 @@ use crate::element::{BulkViscosity, StepInput};
 use crate::forces::element_loop;
 use crate::model::{ElementTotals, Model, SolverError};
 use crate::nodal_update::{constrained_chunks, NodalUpdate, StepParams, StepSums, NODE_CHUNK};
+use crate::subcycle::{self, Subcycling};
 use rayon::prelude::*;
 use std::time::{Duration, Instant};
 
@@ -194,6 +195,9 @@ pub struct LoopSettings {
     pub hourglass_limit: Option<HourglassLimit>,
     /// The element kernels' number type (default `f64`).
     pub precision: Precision,
+    /// Subcycling: the most steps a slow part's interior may take as one
+    /// ([`crate::subcycle`]); 1 (the default) is off.
+    pub subcycling: u32,
 }
 
 /// The hourglass guard: a run whose hourglass energy exceeds `ratio` x internal energy at any
@@ -220,6 +224,7 @@ impl Default for LoopSettings {
             dt_min: 0.0,
             hourglass_limit: None,
             precision: Precision::F64,
+            subcycling: 1,
         }
     }
 }
@@ -276,6 +281,9 @@ pub struct Simulation {
     pub timers: Vec<StageTime>,
     /// Elements eroded so far.
     pub erosion: Erosion,
+    /// The subcycling partition and its macro clock, once the first step has formed it (when
+    /// `settings.subcycling` > 1 and some part is slow enough).
+    pub subcycling: Option<Subcycling>,
     totals: ElementTotals,
     initialised: bool,
     hg_dissipated: f64,
@@ -376,6 +384,7 @@ impl Simulation {
             residual: f64::INFINITY,
             timers,
             erosion: Erosion::default(),
+            subcycling: None,
             totals: ElementTotals::default(),
             initialised: false,
             hg_dissipated: 0.0,
@@ -405,6 +414,9 @@ impl Simulation {
             .any(|g| !g.density_scale.is_empty())
         {
             s.push("mass scaling".into());
+        }
+        if self.subcycling.is_some() {
+            s.push("subcycling".into());
         }
         if self.settings.damping.is_some() {
             s.push("mass-proportional damping".into());
@@ -436,11 +448,17 @@ impl Simulation {
 
     /// Compute internal forces at the current state. `want_stress` also fills `self.stress`.
     fn internal_forces(&mut self, want_stress: bool) -> Result<(), SolverError> {
+        let first = !self.initialised;
+        let macro_dt = match &mut self.subcycling {
+            Some(s) => s.evaluation(self.time, first, want_stress),
+            None => Some(self.dt_prev),
+        };
         let input = StepInput {
             dt: self.dt_prev,
             bulk: self.settings.bulk,
             want_stress,
             precision: self.settings.precision,
+            macro_dt,
         };
         let t0 = Instant::now();
         let stress = if want_stress {
@@ -513,7 +531,8 @@ impl Simulation {
             part_mass,
             ..
         } = &mut self.model;
-        for g in groups.iter_mut() {
+        // a group not evaluated in this step (subcycling) holds its last chunks' results
+        for g in groups.iter_mut().filter(|g| g.evaluated) {
             let rho = parts[g.part].material.density();
             for ch in g.chunks.iter() {
                 for &(le, s_new) in &ch.rescale {
@@ -662,9 +681,53 @@ impl Simulation {
     /// Compute the forces of the initial state (called by the first step if not before).
     pub fn initialise(&mut self) -> Result<(), SolverError> {
         if !self.initialised {
+            if self.settings.subcycling > 1 {
+                self.partition_for_subcycling()?;
+            }
             self.internal_forces(self.stress.is_some())?;
             self.initialised = true;
         }
+        Ok(())
+    }
+
+    /// Form the subcycling partition ([`crate::subcycle::plan`]) and split the model's groups
+    /// by it, before the first force evaluation. Nodes with a kinematic condition or a load,
+    /// and the nodes a force stage reads, stay fast; a stage that reads every node leaves
+    /// nothing to subcycle.
+    fn partition_for_subcycling(&mut self) -> Result<(), SolverError> {
+        if self.settings.relaxation.is_some() {
+            return Err(SolverError::Invalid(
+                "subcycling cannot be combined with dynamic relaxation (its damping is formed from \
+                 every node's force at every step): set run.subcycling = 1"
+                    .into(),
+            ));
+        }
+        let mut pinned: Vec<bool> = self
+            .dof_code
+            .chunks(3)
+            .map(|c| c.iter().any(|&k| k != 0))
+            .collect();
+        for l in &self.loads {
+            for &n in &l.nodes {
+                pinned[n as usize] = true;
+            }
+        }
+        for st in &self.stages {
+            let Some(nodes) = st.nodes_read() else {
+                return Ok(());
+            };
+            for &n in nodes {
+                pinned[n as usize] = true;
+            }
+        }
+        let m = &self.model;
+        let Some(plan) = subcycle::plan(m, &m.part_dt, &pinned, self.settings.subcycling) else {
+            return Ok(());
+        };
+        let parts = self
+            .model
+            .split_for_subcycling(&plan.slow_element, plan.k)?;
+        self.subcycling = Some(Subcycling::new(&plan, parts));
         Ok(())
     }
 
@@ -805,6 +868,9 @@ impl Simulation {
         };
         let damping = relax || self.settings.damping.is_some();
         self.kinematic_targets(t, dt);
+        if let Some(sc) = &mut self.subcycling {
+            sc.weigh(&mut self.f_int, &mut self.f_ext, dt, dt_old);
+        }
         let s = self.integrate(StepParams {
             dt,
             dt_old,

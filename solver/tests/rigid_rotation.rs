@@ -63,6 +63,7 @@ fn max_stress_in(form: Formulation, precision: Precision, shift: [f64; 3]) -> f6
         bulk: None,
         want_stress: true,
         precision,
+        macro_dt: None,
     };
     let Model { parts, groups, .. } = &mut model;
     element_loop(

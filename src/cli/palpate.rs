@@ -84,6 +84,11 @@ pub struct PalpateArgs {
     /// preset's (f64 for standard, f32 for fast).
     #[arg(long)]
     pub precision: Option<String>,
+    /// Subcycling: the interior of a part whose stable step is many times the run's (the
+    /// liver's, beside the flesh's) steps up to this many times longer (a power of two; 1, the
+    /// default, is off). Its measured time and error: docs/performance.md, "Subcycling".
+    #[arg(long, default_value_t = 1)]
+    pub subcycle: u32,
     /// Skip the VTK frames.
     #[arg(long)]
     pub no_vtk: bool,
@@ -158,6 +163,13 @@ impl PalpateArgs {
             s.precision = solver::element::precision::Precision::parse(p)
                 .map_err(|e| format!("--precision: {e}"))?;
         }
+        if !(1..=1024).contains(&self.subcycle) || !self.subcycle.is_power_of_two() {
+            return Err(format!(
+                "--subcycle: must be a power of two from 1 (off) to 1024, got {}",
+                self.subcycle
+            ));
+        }
+        s.subcycling = self.subcycle;
         s.vtk = !self.no_vtk;
         s.title = match &s.place {
             Place::Named(n) => format!("palpation at {n}"),

@@ -53,6 +53,20 @@ pub fn print_summary(s: &RunSummary) {
         percent(s.max_energy_error)
     );
     println!("  active stages: {}", s.active_stages.join(", "));
+    if let Some(sc) = &s.subcycling {
+        let parts: Vec<String> = sc
+            .parts
+            .iter()
+            .map(|(p, n, all)| format!("{p} {n} of {all} elements"))
+            .collect();
+        println!(
+            "  subcycling: every {} steps for {} ({} slow nodes); {:.1} % of element evaluations skipped",
+            sc.ratio,
+            parts.join(", "),
+            sc.slow_nodes,
+            100.0 * sc.saved_fraction
+        );
+    }
     println!("  where the time went:");
     for st in &s.stage_times {
         println!(

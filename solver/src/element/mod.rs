@@ -158,6 +158,10 @@ pub struct StepInput {
     pub want_stress: bool,
     /// The kernels' number type.
     pub precision: precision::Precision,
+    /// Subcycling ([`crate::subcycle`]): at a macro time, the macro step the slow groups'
+    /// laws integrate over (it replaces `dt` for them); `None` between macro times, when
+    /// they are not evaluated. Irrelevant in a run without subcycling.
+    pub macro_dt: Option<f64>,
 }
 
 /// What one element (or one batch of elements, one per lane) returns besides its nodal forces.
