@@ -70,6 +70,7 @@
 //! # fidelity = "fast"             # 1pt-physical, K/G <= 5000, f32, 1.3x mass scaling (docs/palpate.md)
 //! # precision = "f32"              # element kernels: f64 (default) | f32
 //! # max_bulk_ratio = 5000           # or the K/G cap alone
+//! # subcycling = 16                # the liver's interior on a 16x longer step (docs/palpate.md)
 //! vtk = false                      # VTK frames of every run (off: only the probe files)
 //! ```
 //!
@@ -186,6 +187,26 @@ mod tests {
             let e = spec.resolve().unwrap_err();
             assert!(e.contains("solver.fidelity"), "{e}");
         }
+    }
+
+    /// `[solver] subcycling` reaches every run's scene and the plan's identity (so a resumed
+    /// campaign cannot mix runs with and without it); a ratio that is not a power of two is
+    /// refused naming the key.
+    #[test]
+    fn subcycling_reaches_the_scene_and_the_plan() {
+        let spec: CampaignSpec = toml::from_str("[solver]\nsubcycling = 16\n").unwrap();
+        let c = spec.resolve().unwrap();
+        assert_eq!(c.base.subcycling, 16);
+        assert!(c.base.scene_toml().contains("subcycling = 16"));
+        let plain: CampaignSpec = toml::from_str("[solver]\n").unwrap();
+        assert!(!plain
+            .resolve()
+            .unwrap()
+            .base
+            .scene_toml()
+            .contains("subcycling"));
+        let spec: CampaignSpec = toml::from_str("[solver]\nsubcycling = 12\n").unwrap();
+        assert!(spec.resolve().unwrap_err().contains("solver.subcycling"));
     }
 
     /// `[locations] phases` presses every location without a phase of its own at each phase,

@@ -193,6 +193,8 @@ impl Campaign {
                 max_bulk_ratio: b.max_bulk_ratio,
                 // so does the kernels' precision (only when not the default, as above)
                 precision: (b.precision != Precision::F64).then(|| b.precision.label().into()),
+                // and subcycling's integration (only when on)
+                subcycling: (b.subcycling > 1).then_some(b.subcycling),
             },
             phantom: PhantomRecord::of(&ph.params),
             roi: PlanRoi {
@@ -280,6 +282,9 @@ pub struct PlanSettings {
     /// The element kernels' precision; absent when `f64` (the default).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub precision: Option<String>,
+    /// Subcycling's largest macro ratio; absent when off (the default).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub subcycling: Option<u32>,
 }
 
 /// The ROI of a plan.

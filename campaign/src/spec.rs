@@ -173,6 +173,9 @@ pub struct SolverSpec {
     /// The incompressibility knob: cap every part's bulk modulus at this multiple of its
     /// shear modulus (as `palpate --max-bulk-ratio`).
     pub max_bulk_ratio: Option<Number>,
+    /// Subcycling's largest macro ratio, a power of two (as `palpate --subcycle`; 1, the
+    /// default, is off).
+    pub subcycling: Option<u32>,
 }
 
 /// `v` with at most `d` decimals, trailing zeros removed.
@@ -422,6 +425,14 @@ fn apply_solver(sv: &SolverSpec, base: &mut PalpationSetup) -> Result<(), String
     }
     if let Some(l) = sv.mass_scaling_limit {
         base.mass_scaling_limit = l.0;
+    }
+    if let Some(k) = sv.subcycling {
+        if !(1..=1024).contains(&k) || !k.is_power_of_two() {
+            return Err(format!(
+                "solver.subcycling: must be a power of two from 1 (off) to 1024, got {k}"
+            ));
+        }
+        base.subcycling = k;
     }
     base.vtk = sv.vtk.unwrap_or(false);
     Ok(())
