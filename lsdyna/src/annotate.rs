@@ -115,6 +115,9 @@ pub struct RunNote {
     /// The element kernels' number type (`"f32"`; absent: `f64`). LS-DYNA chooses its
     /// precision by executable, so palpa keeps it in the note.
     pub precision: Option<String>,
+    /// Subcycling's largest macro ratio (absent: off). palpa's partition and clock are its
+    /// own, so the deck keeps the setting in the note rather than in an LS-DYNA keyword.
+    pub subcycling: Option<u32>,
 }
 
 /// Dynamic relaxation (the scene's `[relaxation]`).

@@ -583,6 +583,13 @@ pub fn export(scene: &Scene, opts: &ExportOptions) -> Result<Exported, String> {
             setup.precision.label()
         ));
     }
+    if setup.subcycling > 1 {
+        run_note.push(format!("subcycling = {}", setup.subcycling));
+        notes.push(format!(
+            "run.subcycling = {} is palpa's own nodal-partition subcycling, not written as an LS-DYNA keyword: a $palpa comment",
+            setup.subcycling
+        ));
+    }
     if !run_note.is_empty() {
         w.palpa("run", &format!("{{ {} }}", run_note.join(", ")));
     }

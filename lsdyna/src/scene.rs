@@ -996,6 +996,16 @@ fn build(cx: &mut Ctx, path: &Path) -> Result<SceneDef, Vec<String>> {
             }
         },
     };
+    let subcycling = match run_note.subcycling {
+        None => 1,
+        Some(k) if (1..=1024).contains(&k) && k.is_power_of_two() => k,
+        Some(k) => {
+            errors.push(format!(
+                "{hdr_at}: $palpa run: subcycling: must be a power of two from 1 (off) to 1024, got {k}"
+            ));
+            1
+        }
+    };
     let hourglass_guard = run_note.max_hourglass_ratio.map(|ratio| HourglassGuard {
         ratio,
         after: run_note.hourglass_check_after,
@@ -1171,8 +1181,8 @@ fn build(cx: &mut Ctx, path: &Path) -> Result<SceneDef, Vec<String>> {
             dt_max,
             dt_min,
             max_steps: None,
-            // *CONTROL_SUBCYCLING is not read: decks run without subcycling
-            subcycling: 1,
+            // LS-DYNA's own subcycling keyword is not read; palpa's is kept in its note
+            subcycling,
             hourglass_guard,
             bulk,
             damping,

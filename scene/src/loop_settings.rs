@@ -121,7 +121,6 @@ pub(crate) fn settings(spec: &SceneSpec, at: Locate) -> Result<Settings, String>
     })
 }
 
-/// `[run] max_steps`, checked.
 /// `[run] subcycling`: the most steps a slow part's interior may take as one (a power of two
 /// from 1, off, to 1024; [`solver::subcycle`]).
 pub(crate) fn subcycling(run: &RunSpec, at: Locate) -> Result<u32, String> {
@@ -140,6 +139,7 @@ pub(crate) fn subcycling(run: &RunSpec, at: Locate) -> Result<u32, String> {
     }
 }
 
+/// `[run] max_steps`, checked.
 pub(crate) fn max_steps(run: &RunSpec, at: Locate) -> Result<Option<f64>, String> {
     Ok(match run.max_steps.map(|x| x.0) {
         None => None,

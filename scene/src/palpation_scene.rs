@@ -259,19 +259,18 @@ impl PalpationSetup {
             "# A two-finger palpation of the built-in abdomen phantom, written by palpa.\n\
              # Run it again with `palpa run scene.toml --out DIR`.\n"
         );
+        let subcycling = match self.subcycling {
+            1 => String::new(),
+            k => format!("subcycling = {k}\n"),
+        };
         let _ = writeln!(
             s,
-            "[run]\ntitle = {}\nend_time = \"{} s\"\ndt_factor = {}\nprecision = {:?}\n",
+            "[run]\ntitle = {}\nend_time = \"{} s\"\ndt_factor = {}\nprecision = {:?}\n{subcycling}",
             toml_str(&self.title),
             self.duration,
             toml_num(self.dt_factor),
             self.precision.label()
         );
-        if self.subcycling > 1 {
-            // inside [run]: the blank line above ends the table only in looks
-            s.pop();
-            let _ = writeln!(s, "subcycling = {}\n", self.subcycling);
-        }
         self.write_mesh(&mut s);
         self.write_parts(&mut s);
         s.push_str("[[boundary]]\nnodes = \"back\"\nfix = [\"all\"]\n\n");

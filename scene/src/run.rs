@@ -751,7 +751,15 @@ fn summarise(scene: &Scene, wall: f64, status: RunStatus, rec: &Recorder) -> Run
             .iter()
             .filter_map(|p| p.bulk.clone())
             .collect(),
-        warnings: energy_warnings(e.internal, e.hourglass, &hourglass),
+        warnings: energy_warnings(e.internal, e.hourglass, &hourglass)
+            .into_iter()
+            .chain(sim.subcycling_off.as_ref().map(|why| {
+                format!(
+                    "subcycling was asked for (run.subcycling = {}) but not used: {why}",
+                    sim.settings.subcycling
+                )
+            }))
+            .collect(),
         hourglass,
         threads: rayon::current_num_threads(),
         frames: rec.series.len(),

@@ -148,7 +148,12 @@ pub fn element_loop(
         // step; between them it reports the totals of its last evaluation.
         let input = &match (g.subcycle, input.macro_dt) {
             (1, _) => *input,
-            (_, Some(big)) => StepInput { dt: big, ..*input },
+            // its stress is written at every evaluation when the run keeps stress
+            (_, Some(big)) => StepInput {
+                dt: big,
+                want_stress: stress_ptr.is_some(),
+                ..*input
+            },
             (_, None) => {
                 g.evaluated = false;
                 tot.combine(&g.held);
@@ -172,7 +177,7 @@ pub fn element_loop(
             v,
             input,
             hist,
-            stress: stress_ptr,
+            stress: stress_ptr.filter(|_| input.want_stress),
             force: force_ptr,
         };
         with_law!(&part.material, l => {
@@ -203,7 +208,7 @@ pub fn element_loop(
                 g.eroded[le as usize] = true;
             }
             let c = ElementTotals {
-                dt_min: ch.totals.dt_min * g.dt_kappa / g.subcycle as f64,
+                dt_min: ch.totals.dt_min * g.dt_kappa / g.step_ratio as f64,
                 ..ch.totals
             };
             tot.combine(&c);

@@ -258,6 +258,9 @@ pub struct Group {
     /// Steps per force evaluation: 1, or the macro ratio `k` of a subcycled run's slow
     /// elements ([`crate::subcycle`]).
     pub subcycle: u32,
+    /// The group reports its stable step divided by this: `k` for both groups of a
+    /// subcycled part, 1 otherwise.
+    pub step_ratio: u32,
     /// A subcycled group's totals from its last evaluation, reported in the steps between
     /// (its law dissipation only once).
     pub held: ElementTotals,
@@ -618,23 +621,13 @@ impl Model {
             Some(StepTarget::Step(t)) => Some(t),
             Some(StepTarget::Initial(k)) => Some(k * dt_factor * natural_step(&mesh, &parts)),
         };
-        let mut builder = Builder {
-            mesh: &mesh,
+        let mut builder = Builder::new(
+            &mesh,
+            &parts,
             dt_factor,
-            target: fixed_target,
-            scaling: mass_scaling.is_some(),
-            mass: vec![0.0; mesh.nodes.len()],
-            part_mass: parts
-                .iter()
-                .map(|p| PartMass {
-                    name: p.name.clone(),
-                    ..Default::default()
-                })
-                .collect(),
-            initial_dt: (f64::INFINITY, 0u32),
-            scaled_dt: f64::INFINITY,
-            part_dt: vec![f64::INFINITY; parts.len()],
-        };
+            fixed_target,
+            mass_scaling.is_some(),
+        );
         let mut groups = Vec::new();
         for (pi, part) in parts.iter().enumerate() {
             let mut elems: Vec<u32> = (0..mesh.elements.len() as u32)
@@ -696,17 +689,10 @@ impl Model {
         slow: &[bool],
         k: u32,
     ) -> Result<Vec<(String, usize, usize)>, SolverError> {
-        let mut builder = Builder {
-            mesh: &self.mesh,
-            dt_factor: self.dt_factor,
-            target: self.mass_scaling.map(|m| m.target_dt),
-            scaling: self.mass_scaling.is_some(),
-            mass: vec![0.0; self.mesh.nodes.len()],
-            part_mass: vec![PartMass::default(); self.parts.len()],
-            initial_dt: (f64::INFINITY, 0u32),
-            scaled_dt: f64::INFINITY,
-            part_dt: vec![f64::INFINITY; self.parts.len()],
-        };
+        // a fresh builder: its masses and reports are discarded (the model has them)
+        let target = self.mass_scaling.map(|m| m.target_dt);
+        let scaling = self.mass_scaling.is_some();
+        let mut builder = Builder::new(&self.mesh, &self.parts, self.dt_factor, target, scaling);
         let mut groups = Vec::with_capacity(self.groups.len() + 1);
         let mut split = Vec::new();
         for g in std::mem::take(&mut self.groups) {
@@ -717,10 +703,18 @@ impl Model {
             }
             let part = &self.parts[g.part];
             split.push((part.name.clone(), s.len(), g.elements.len()));
+            // both groups report their step over k (the slow nodes take the macro step under
+            // the boundary elements' stiffness too), and mass scaling keeps its target on the
+            // same terms
+            let ratio = |mut h: Group| {
+                h.step_ratio = k;
+                h.dt_floor *= k as f64;
+                h
+            };
             if !f.is_empty() {
-                groups.push(builder.group(g.part, part, f)?);
+                groups.push(ratio(builder.group(g.part, part, f)?));
             }
-            let mut sg = builder.group(g.part, part, s)?;
+            let mut sg = ratio(builder.group(g.part, part, s)?);
             sg.subcycle = k;
             groups.push(sg);
         }
@@ -822,7 +816,35 @@ struct ElementData {
     gp_weight: Vec<[f64; 8]>,
 }
 
-impl Builder<'_> {
+impl<'m> Builder<'m> {
+    /// A builder with nothing added yet: `target` is mass scaling's target step (s), if any;
+    /// `scaling` whether mass scaling is on.
+    fn new(
+        mesh: &'m Mesh,
+        parts: &[Part],
+        dt_factor: f64,
+        target: Option<f64>,
+        scaling: bool,
+    ) -> Builder<'m> {
+        Builder {
+            mesh,
+            dt_factor,
+            target,
+            scaling,
+            mass: vec![0.0; mesh.nodes.len()],
+            part_mass: parts
+                .iter()
+                .map(|p| PartMass {
+                    name: p.name.clone(),
+                    ..Default::default()
+                })
+                .collect(),
+            initial_dt: (f64::INFINITY, 0u32),
+            scaled_dt: f64::INFINITY,
+            part_dt: vec![f64::INFINITY; parts.len()],
+        }
+    }
+
     /// The group of part `pi`, whose elements are `elems`: reference data, history and chunk
     /// colouring. Adds the elements' masses and initial steps to the builder's totals.
     fn group(&mut self, pi: usize, part: &Part, elems: Vec<u32>) -> Result<Group, SolverError> {
@@ -952,6 +974,7 @@ fn empty_group(part: usize, elements: Vec<u32>, stride: usize) -> Group {
         dt_floor: 0.0,
         lumped: Vec::new(),
         subcycle: 1,
+        step_ratio: 1,
         held: ElementTotals::EMPTY,
         evaluated: false,
     }

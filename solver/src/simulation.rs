@@ -284,6 +284,8 @@ pub struct Simulation {
     /// The subcycling partition and its macro clock, once the first step has formed it (when
     /// `settings.subcycling` > 1 and some part is slow enough).
     pub subcycling: Option<Subcycling>,
+    /// Why a run that asked for subcycling has none.
+    pub subcycling_off: Option<String>,
     totals: ElementTotals,
     initialised: bool,
     hg_dissipated: f64,
@@ -385,6 +387,7 @@ impl Simulation {
             timers,
             erosion: Erosion::default(),
             subcycling: None,
+            subcycling_off: None,
             totals: ElementTotals::default(),
             initialised: false,
             hg_dissipated: 0.0,
@@ -449,9 +452,14 @@ impl Simulation {
     /// Compute internal forces at the current state. `want_stress` also fills `self.stress`.
     fn internal_forces(&mut self, want_stress: bool) -> Result<(), SolverError> {
         let first = !self.initialised;
-        let macro_dt = match &mut self.subcycling {
-            Some(s) => s.evaluation(self.time, first, want_stress),
-            None => Some(self.dt_prev),
+        let (macro_dt, slow_stress) = match &mut self.subcycling {
+            // the slow groups write their stress at every macro time (an output step between
+            // two shows the last one's)
+            Some(s) => {
+                let m = s.evaluation(self.time, first);
+                (m, m.is_some())
+            }
+            None => (Some(self.dt_prev), false),
         };
         let input = StepInput {
             dt: self.dt_prev,
@@ -461,7 +469,7 @@ impl Simulation {
             macro_dt,
         };
         let t0 = Instant::now();
-        let stress = if want_stress {
+        let stress = if want_stress || slow_stress {
             self.stress.as_deref_mut()
         } else {
             None
@@ -714,6 +722,7 @@ impl Simulation {
         }
         for st in &self.stages {
             let Some(nodes) = st.nodes_read() else {
+                self.subcycling_off = Some("a force stage reads every node".into());
                 return Ok(());
             };
             for &n in nodes {
@@ -722,6 +731,9 @@ impl Simulation {
         }
         let m = &self.model;
         let Some(plan) = subcycle::plan(m, &m.part_dt, &pinned, self.settings.subcycling) else {
+            self.subcycling_off = Some(
+                "no part's interior can step at least twice as long as the model's step".into(),
+            );
             return Ok(());
         };
         let parts = self

@@ -16,30 +16,39 @@
 //!   acts on it: no kinematic condition, no nodal load, not read by a force stage (contact).
 //!   Every other node is *fast*.
 //! - An element of a slow part whose eight nodes are all slow is a slow element: it is
-//!   evaluated only at the macro times `t_N`, every `k` steps (and at every step whose stress
-//!   is written), with the step `T = t_N - t_(N-1)` passed to its law (viscous and damping
-//!   history). The other elements, those of a slow part that touch a fast node among them,
-//!   are evaluated every step.
+//!   evaluated only at the macro times `t_N`, every `k` steps from the first, with the step
+//!   `T = t_N - t_(N-1)` passed to its law (viscous and damping history). The other elements,
+//!   those of a slow part that touch a fast node, are evaluated every step. The clock never
+//!   changes its period: output does not force a macro time, so the motion does not depend on
+//!   the output schedule. A slow element's stress is written at each macro time, so an output
+//!   step shows the stress of the last one, at most `k - 1` steps earlier.
 //! - Fast nodes take the central-difference step `dt` as usual. A slow node takes it with
 //!   the macro step: its force (from the slow elements and the interface elements at `t_N`)
 //!   acts only at `t_N`, where its velocity update is
 //!
 //!   ```text
-//!   v^(N+1/2) = v^(N-1/2) + (T^(N-1/2) + T^(N+1/2)) / 2 f^N / m,      T^(N+1/2) = k dt,
+//!   v^(N+1/2) = v^(N-1/2) + (T^(N-1/2) + T^(N+1/2)) / 2 f^N / m,      T^(N+1/2) ~ k dt,
 //!   ```
 //!
-//!   and between macro times it has no force, so it moves at constant velocity: the interface
-//!   elements see its displacement interpolated linearly in time, as the scheme requires. The
-//!   update is the ordinary one with the slow nodes' forces multiplied by
-//!   `w = (T^(N-1/2) + k dt) / (dt^(n-1/2) + dt^(n+1/2))` at macro times and by zero between
-//!   them ([`Subcycling::weigh`]), so the energy sums of the update (trapezoidal works) book
-//!   the slow nodes' work over the macro step.
-//! - Stability: the slow elements report their step divided by `k` to the run's step choice,
-//!   so `k dt` never exceeds their own stable step; the fast elements and the interface
-//!   elements keep theirs with `dt`. Belytschko & Mullen showed the nodal partition stable
-//!   under these element-wise limits for linear systems; Daniel (1997, IJNME 40: 2841-2855)
-//!   found narrow unstable bands of the linear-interpolation scheme in undamped systems. The
-//!   run's stability guard (negative internal energy, non-finite energies) stops such a run.
+//!   and between macro times only mass-proportional damping (if any) acts on it, so without
+//!   damping it moves at constant velocity: the interface elements see its displacement
+//!   interpolated linearly in time, as the scheme requires. The update is the ordinary one
+//!   with the slow nodes' forces multiplied by `w = (B + k dt) / (dt^(n-1/2) + dt^(n+1/2))`
+//!   at macro times and by zero between them ([`Subcycling::weigh`]), so the energy sums of
+//!   the update (trapezoidal works) book the slow nodes' work over the macro step.
+//!   `T^(N+1/2)` is not known at `t_N` when the step varies, so the forward half uses `k dt`
+//!   and the next macro time books the difference: `B = 2 T^(N-1/2) - k dt^(N-1)`, so that
+//!   each macro interval's two halves add up to its true length (`B = T^(N-1/2)` at a
+//!   constant step).
+//! - Stability: every element of a slow part, slow or at its boundary, reports its step
+//!   divided by `k` to the run's step choice, since the slow nodes take the macro step under
+//!   the stiffness of both; so `k dt` stays below their stable steps. The factor 2 of the
+//!   partition makes that free at the start. Run-time mass scaling keeps its target for those
+//!   elements on the same terms (its floor is multiplied by `k`). The fast parts keep theirs
+//!   with `dt`. Belytschko & Mullen showed the nodal partition stable under these
+//!   element-wise limits for linear systems; Daniel (1997, IJNME 40: 2841-2855) found narrow
+//!   unstable bands of the linear-interpolation scheme in undamped systems. The run's
+//!   stability guard (negative internal energy, non-finite energies) stops such a run.
 //!
 //! # What it saves, and what it costs
 //!
@@ -67,6 +76,8 @@ pub struct Subcycling {
     t_before: f64,
     /// Whether the coming update starts at a macro time (the slow nodes' forces apply).
     pending: bool,
+    /// The forward half the last macro time assumed, `k dt` (s).
+    ahead: f64,
     /// Element evaluations saved so far (slow elements not evaluated in a step).
     pub saved: u64,
     slow_elements: usize,
@@ -151,16 +162,16 @@ impl Subcycling {
             t_macro: 0.0,
             t_before: 0.0,
             pending: false,
+            ahead: 0.0,
             saved: 0,
         }
     }
 
-    /// Whether the force evaluation at time `t` is a macro time: the first one, every `k`-th
-    /// step, and any step whose stress is written. On a macro time returns `Some(T)`, the
-    /// macro step that ends there (the step the slow elements' laws take), and starts the
-    /// next macro step.
-    pub fn evaluation(&mut self, t: f64, first: bool, want_stress: bool) -> Option<f64> {
-        if first || want_stress || self.since >= self.k {
+    /// Whether the force evaluation at time `t` is a macro time: the first one and every
+    /// `k`-th step after it. On a macro time returns `Some(T)`, the macro step that ends there
+    /// (the step the slow elements' laws take), and starts the next macro step.
+    pub fn evaluation(&mut self, t: f64, first: bool) -> Option<f64> {
+        if first || self.since >= self.k {
             let big = if first { 0.0 } else { t - self.t_macro };
             self.t_before = big;
             self.t_macro = t;
@@ -174,11 +185,14 @@ impl Subcycling {
     }
 
     /// Weigh the slow nodes' forces for the update from t^n with the step `dt` (the step
-    /// before was `dt_old`): by `(T^(N-1/2) + k dt) / (dt_old + dt)` at a macro time, else by
-    /// zero (see the module doc). Advances the clock by one step.
+    /// before was `dt_old`): by `(B + k dt) / (dt_old + dt)` at a macro time, with
+    /// `B = 2 T^(N-1/2) - k dt^(N-1)` the backward half that completes the last macro
+    /// interval; else by zero (see the module doc). Advances the clock by one step.
     pub fn weigh(&mut self, f_int: &mut [[f64; 3]], f_ext: &mut [[f64; 3]], dt: f64, dt_old: f64) {
         let w = if self.pending {
-            (self.t_before + self.k as f64 * dt) / (dt_old + dt)
+            let back = 2.0 * self.t_before - self.ahead;
+            self.ahead = self.k as f64 * dt;
+            (back + self.ahead) / (dt_old + dt)
         } else {
             0.0
         };
