@@ -173,6 +173,8 @@ pub struct SubcyclingReport {
     pub slow_nodes: usize,
     /// Element evaluations the run skipped, as a fraction of elements x steps.
     pub saved_fraction: f64,
+    /// Steps whose stable step an element of a slow part set (its own over the ratio).
+    pub slow_bound_steps: u64,
 }
 
 impl RunSummary {
@@ -717,6 +719,7 @@ fn summarise(scene: &Scene, wall: f64, status: RunStatus, rec: &Recorder) -> Run
             slow_nodes: s.slow_nodes.len(),
             saved_fraction: s.saved as f64
                 / (sim.model.mesh.elements.len() as f64 * sim.step.max(1) as f64),
+            slow_bound_steps: s.slow_bound_steps,
         }),
         dt_min: sim.dt_range.0,
         dt_max: sim.dt_range.1,
@@ -759,6 +762,17 @@ fn summarise(scene: &Scene, wall: f64, status: RunStatus, rec: &Recorder) -> Run
                     sim.settings.subcycling
                 )
             }))
+            .chain(
+                sim.subcycling
+                    .as_ref()
+                    .filter(|s| s.slow_bound_steps > 0)
+                    .map(|s| {
+                        format!(
+                            "subcycling: an element of a subcycled part set the step in {} of {} steps (its own step over {}): those steps were shorter than without subcycling; a smaller run.subcycling may be faster",
+                            s.slow_bound_steps, sim.step, s.k
+                        )
+                    }),
+            )
             .collect(),
         hourglass,
         threads: rayon::current_num_threads(),

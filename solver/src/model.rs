@@ -687,6 +687,7 @@ impl Model {
     pub fn split_for_subcycling(
         &mut self,
         slow: &[bool],
+        slow_part: &[bool],
         k: u32,
     ) -> Result<Vec<(String, usize, usize)>, SolverError> {
         // a fresh builder: its masses and reports are discarded (the model has them)
@@ -695,22 +696,26 @@ impl Model {
         let mut builder = Builder::new(&self.mesh, &self.parts, self.dt_factor, target, scaling);
         let mut groups = Vec::with_capacity(self.groups.len() + 1);
         let mut split = Vec::new();
+        // every group of a slow part reports its step over k (the slow nodes take the macro
+        // step under its elements' stiffness too), and mass scaling keeps its target on the
+        // same terms
+        let ratio = |mut h: Group| {
+            h.step_ratio = k;
+            h.dt_floor *= k as f64;
+            h
+        };
         for g in std::mem::take(&mut self.groups) {
             let (s, f): (Vec<u32>, Vec<u32>) = g.elements.iter().partition(|&&e| slow[e as usize]);
             if s.is_empty() {
-                groups.push(g);
+                // a slow part without slow elements still borders slow nodes
+                groups.push(match slow_part[g.part] {
+                    true => ratio(g),
+                    false => g,
+                });
                 continue;
             }
             let part = &self.parts[g.part];
             split.push((part.name.clone(), s.len(), g.elements.len()));
-            // both groups report their step over k (the slow nodes take the macro step under
-            // the boundary elements' stiffness too), and mass scaling keeps its target on the
-            // same terms
-            let ratio = |mut h: Group| {
-                h.step_ratio = k;
-                h.dt_floor *= k as f64;
-                h
-            };
             if !f.is_empty() {
                 groups.push(ratio(builder.group(g.part, part, f)?));
             }

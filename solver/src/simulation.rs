@@ -498,6 +498,9 @@ impl Simulation {
             reason,
         })?;
         self.totals = tot;
+        if let Some(sc) = &mut self.subcycling {
+            sc.note_step_set_by(tot.dt_elem);
+        }
         if self.model.mass_scaling.is_some() {
             self.time_stage(Stage::MassScaling as usize, |s| {
                 s.apply_run_time_mass_scaling()
@@ -732,14 +735,16 @@ impl Simulation {
         let m = &self.model;
         let Some(plan) = subcycle::plan(m, &m.part_dt, &pinned, self.settings.subcycling) else {
             self.subcycling_off = Some(
-                "no part's interior can step at least twice as long as the model's step".into(),
+                "no part has a stable step of at least 4 times the model's with an element \
+                 whose nodes all lie inside it, away from conditions, loads and contact"
+                    .into(),
             );
             return Ok(());
         };
         let parts = self
             .model
-            .split_for_subcycling(&plan.slow_element, plan.k)?;
-        self.subcycling = Some(Subcycling::new(&plan, parts));
+            .split_for_subcycling(&plan.slow_element, &plan.slow_part, plan.k)?;
+        self.subcycling = Some(Subcycling::new(&plan, &self.model, parts));
         Ok(())
     }
 

@@ -39,13 +39,17 @@
 //!   `T^(N+1/2)` is not known at `t_N` when the step varies, so the forward half uses `k dt`
 //!   and the next macro time books the difference: `B = 2 T^(N-1/2) - k dt^(N-1)`, so that
 //!   each macro interval's two halves add up to its true length (`B = T^(N-1/2)` at a
-//!   constant step).
+//!   constant step). Should the step fall to under half within one macro interval, `B` would
+//!   be negative: it is then taken as zero and the rest booked at the next macro time.
 //! - Stability: every element of a slow part, slow or at its boundary, reports its step
 //!   divided by `k` to the run's step choice, since the slow nodes take the macro step under
 //!   the stiffness of both; so `k dt` stays below their stable steps. The factor 2 of the
 //!   partition makes that free at the start. Run-time mass scaling keeps its target for those
 //!   elements on the same terms (its floor is multiplied by `k`). The fast parts keep theirs
-//!   with `dt`. Belytschko & Mullen showed the nodal partition stable under these
+//!   with `dt`. The partition is fixed for the run: should a slow part's elements collapse
+//!   until their step over `k` sets the run's step, the run takes shorter steps than it would
+//!   without subcycling, and the summary says in how many steps that happened
+//!   ([`Subcycling::slow_bound_steps`]). Belytschko & Mullen showed the nodal partition stable under these
 //!   element-wise limits for linear systems; Daniel (1997, IJNME 40: 2841-2855) found narrow
 //!   unstable bands of the linear-interpolation scheme in undamped systems. The run's
 //!   stability guard (negative internal energy, non-finite energies) stops such a run.
@@ -78,6 +82,13 @@ pub struct Subcycling {
     pending: bool,
     /// The forward half the last macro time assumed, `k dt` (s).
     ahead: f64,
+    /// What a backward half could not take (it would have been negative), carried to the
+    /// next (s).
+    owed: f64,
+    /// Per element (global id): whether it belongs to a slow part.
+    in_slow_part: Vec<bool>,
+    /// Steps whose stable step an element of a slow part set (its own over `k`).
+    pub slow_bound_steps: u64,
     /// Element evaluations saved so far (slow elements not evaluated in a step).
     pub saved: u64,
     slow_elements: usize,
@@ -89,6 +100,8 @@ pub struct Plan {
     pub k: u32,
     /// Per element (global id): whether it is a slow element.
     pub slow_element: Vec<bool>,
+    /// Per part: whether it is slow (its elements report their step over `k`, split or not).
+    pub slow_part: Vec<bool>,
     /// The slow nodes, ascending.
     pub slow_nodes: Vec<u32>,
 }
@@ -146,13 +159,15 @@ pub fn plan(model: &Model, part_dt: &[f64], pinned: &[bool], max_ratio: u32) -> 
     Some(Plan {
         k,
         slow_element,
+        slow_part,
         slow_nodes,
     })
 }
 
 impl Subcycling {
     /// The macro clock of a run partitioned by `plan`, before its first force evaluation.
-    pub fn new(plan: &Plan, parts: Vec<(String, usize, usize)>) -> Subcycling {
+    pub fn new(plan: &Plan, model: &Model, parts: Vec<(String, usize, usize)>) -> Subcycling {
+        let part = &model.mesh.element_part;
         Subcycling {
             k: plan.k,
             slow_nodes: plan.slow_nodes.clone(),
@@ -163,7 +178,17 @@ impl Subcycling {
             t_before: 0.0,
             pending: false,
             ahead: 0.0,
+            owed: 0.0,
+            in_slow_part: part.iter().map(|&p| plan.slow_part[p as usize]).collect(),
+            slow_bound_steps: 0,
             saved: 0,
+        }
+    }
+
+    /// Count a step whose stable step element `e` set (see [`Subcycling::slow_bound_steps`]).
+    pub fn note_step_set_by(&mut self, e: u32) {
+        if self.in_slow_part.get(e as usize) == Some(&true) {
+            self.slow_bound_steps += 1;
         }
     }
 
@@ -190,7 +215,11 @@ impl Subcycling {
     /// interval; else by zero (see the module doc). Advances the clock by one step.
     pub fn weigh(&mut self, f_int: &mut [[f64; 3]], f_ext: &mut [[f64; 3]], dt: f64, dt_old: f64) {
         let w = if self.pending {
-            let back = 2.0 * self.t_before - self.ahead;
+            // negative only when the step fell to under half within a macro interval: the
+            // rest is booked at the next macro time, so the halves still add up
+            let back = 2.0 * self.t_before - self.ahead - self.owed;
+            self.owed = (-back).max(0.0);
+            let back = back.max(0.0);
             self.ahead = self.k as f64 * dt;
             (back + self.ahead) / (dt_old + dt)
         } else {
