@@ -123,7 +123,7 @@ fn run_bar(k: u32, every: u64, layer: bool) -> Simulation {
     let mut sim =
         Simulation::new(model, settings, constraints, Vec::new(), None, every > 0).unwrap();
     while sim.time < END {
-        let out = every > 0 && (sim.step + 1) % every == 0;
+        let out = every > 0 && (sim.step + 1).is_multiple_of(every);
         sim.step(if out { 0.0 } else { f64::INFINITY }).unwrap();
     }
     sim
