@@ -499,7 +499,7 @@ impl Simulation {
         })?;
         self.totals = tot;
         if let Some(sc) = &mut self.subcycling {
-            sc.note_step_set_by(tot.dt_elem);
+            sc.note_step_set_by(self.model.mesh.element_part[tot.dt_elem as usize] as usize);
         }
         if self.model.mass_scaling.is_some() {
             self.time_stage(Stage::MassScaling as usize, |s| {
@@ -744,7 +744,7 @@ impl Simulation {
         let parts = self
             .model
             .split_for_subcycling(&plan.slow_element, &plan.slow_part, plan.k)?;
-        self.subcycling = Some(Subcycling::new(&plan, &self.model, parts));
+        self.subcycling = Some(Subcycling::new(plan, parts));
         Ok(())
     }
 

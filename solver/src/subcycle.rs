@@ -85,8 +85,8 @@ pub struct Subcycling {
     /// What a backward half could not take (it would have been negative), carried to the
     /// next (s).
     owed: f64,
-    /// Per element (global id): whether it belongs to a slow part.
-    in_slow_part: Vec<bool>,
+    /// Per part: whether it is slow.
+    slow_part: Vec<bool>,
     /// Steps whose stable step an element of a slow part set (its own over `k`).
     pub slow_bound_steps: u64,
     /// Element evaluations saved so far (slow elements not evaluated in a step).
@@ -165,13 +165,13 @@ pub fn plan(model: &Model, part_dt: &[f64], pinned: &[bool], max_ratio: u32) -> 
 }
 
 impl Subcycling {
-    /// The macro clock of a run partitioned by `plan`, before its first force evaluation.
-    pub fn new(plan: &Plan, model: &Model, parts: Vec<(String, usize, usize)>) -> Subcycling {
-        let part = &model.mesh.element_part;
+    /// The macro clock of a run partitioned by `plan` (`parts` as
+    /// [`Model::split_for_subcycling`] reports them), before its first force evaluation.
+    pub fn new(plan: Plan, parts: Vec<(String, usize, usize)>) -> Subcycling {
         Subcycling {
             k: plan.k,
-            slow_nodes: plan.slow_nodes.clone(),
-            slow_elements: plan.slow_element.iter().filter(|&&s| s).count(),
+            slow_nodes: plan.slow_nodes,
+            slow_elements: parts.iter().map(|p| p.1).sum(),
             parts,
             since: 0,
             t_macro: 0.0,
@@ -179,15 +179,16 @@ impl Subcycling {
             pending: false,
             ahead: 0.0,
             owed: 0.0,
-            in_slow_part: part.iter().map(|&p| plan.slow_part[p as usize]).collect(),
+            slow_part: plan.slow_part,
             slow_bound_steps: 0,
             saved: 0,
         }
     }
 
-    /// Count a step whose stable step element `e` set (see [`Subcycling::slow_bound_steps`]).
-    pub fn note_step_set_by(&mut self, e: u32) {
-        if self.in_slow_part.get(e as usize) == Some(&true) {
+    /// Count a step whose stable step an element of part `part` set (see
+    /// [`Subcycling::slow_bound_steps`]).
+    pub fn note_step_set_by(&mut self, part: usize) {
+        if self.slow_part.get(part) == Some(&true) {
             self.slow_bound_steps += 1;
         }
     }
