@@ -71,6 +71,7 @@
 //! # precision = "f32"              # element kernels: f64 (default) | f32
 //! # max_bulk_ratio = 5000           # or the K/G cap alone
 //! # subcycling = 16                # the liver's interior on a 16x longer step (docs/palpate.md)
+//! # step_estimate = "global"       # the mesh's own critical step (docs/performance.md)
 //! vtk = false                      # VTK frames of every run (off: only the probe files)
 //! ```
 //!
@@ -207,6 +208,34 @@ mod tests {
             .contains("subcycling"));
         let spec: CampaignSpec = toml::from_str("[solver]\nsubcycling = 12\n").unwrap();
         assert!(spec.resolve().unwrap_err().contains("solver.subcycling"));
+    }
+
+    /// `[solver] step_estimate` reaches every run's scene and the plan's identity; an unknown
+    /// value, and "global" beside subcycling, are refused naming the key.
+    #[test]
+    fn step_estimate_reaches_the_scene_and_the_plan() {
+        let spec: CampaignSpec = toml::from_str("[solver]\nstep_estimate = \"global\"\n").unwrap();
+        let c = spec.resolve().unwrap();
+        assert_eq!(
+            c.base.step_estimate,
+            solver::simulation::StepEstimate::Global
+        );
+        assert!(c.base.scene_toml().contains("step_estimate = \"global\""));
+        let plain: CampaignSpec = toml::from_str("[solver]\n").unwrap();
+        assert!(!plain
+            .resolve()
+            .unwrap()
+            .base
+            .scene_toml()
+            .contains("step_estimate"));
+        for bad in [
+            "step_estimate = \"nodal\"",
+            "step_estimate = \"global\"\nsubcycling = 4",
+        ] {
+            let spec: CampaignSpec = toml::from_str(&format!("[solver]\n{bad}\n")).unwrap();
+            let e = spec.resolve().unwrap_err();
+            assert!(e.contains("solver.step_estimate"), "{e}");
+        }
     }
 
     /// `[locations] phases` presses every location without a phase of its own at each phase,

@@ -10,6 +10,7 @@ use scene::palpation::{PalpationSetup, Place};
 use scene::Scene;
 use serde::{Deserialize, Serialize};
 use solver::element::precision::Precision;
+use solver::simulation::StepEstimate;
 use std::collections::BTreeMap;
 use std::path::Path;
 pub use surrogate::Split;
@@ -195,6 +196,9 @@ impl Campaign {
                 precision: (b.precision != Precision::F64).then(|| b.precision.label().into()),
                 // and subcycling's integration (only when on)
                 subcycling: (b.subcycling > 1).then_some(b.subcycling),
+                // and the step (only when not the default)
+                step_estimate: (b.step_estimate != StepEstimate::Element)
+                    .then(|| b.step_estimate.name().into()),
             },
             phantom: PhantomRecord::of(&ph.params),
             roi: PlanRoi {
@@ -285,6 +289,9 @@ pub struct PlanSettings {
     /// Subcycling's largest macro ratio; absent when off (the default).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub subcycling: Option<u32>,
+    /// How the stable step is estimated; absent when element by element (the default).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub step_estimate: Option<String>,
 }
 
 /// The ROI of a plan.

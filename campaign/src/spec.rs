@@ -176,6 +176,9 @@ pub struct SolverSpec {
     /// Subcycling's largest macro ratio, a power of two (as `palpate --subcycle`; 1, the
     /// default, is off).
     pub subcycling: Option<u32>,
+    /// How the stable step is estimated, `"element"` (default) or `"global"` (as
+    /// `palpate --step-estimate`).
+    pub step_estimate: Option<String>,
 }
 
 /// `v` with at most `d` decimals, trailing zeros removed.
@@ -433,6 +436,15 @@ fn apply_solver(sv: &SolverSpec, base: &mut PalpationSetup) -> Result<(), String
             ));
         }
         base.subcycling = k;
+    }
+    if let Some(s) = &sv.step_estimate {
+        base.step_estimate = solver::simulation::StepEstimate::parse(s)
+            .map_err(|e| format!("solver.step_estimate: {e}"))?;
+        if base.subcycling > 1 && base.step_estimate != solver::simulation::StepEstimate::Element {
+            return Err(
+                "solver.step_estimate: \"global\" cannot be combined with solver.subcycling".into(),
+            );
+        }
     }
     base.vtk = sv.vtk.unwrap_or(false);
     Ok(())

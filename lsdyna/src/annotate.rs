@@ -118,6 +118,9 @@ pub struct RunNote {
     /// Subcycling's largest macro ratio (absent: off). palpa's partition and clock are its
     /// own, so the deck keeps the setting in the note rather than in an LS-DYNA keyword.
     pub subcycling: Option<u32>,
+    /// How the stable step is estimated (`"global"`; absent: element by element). LS-DYNA has
+    /// no global estimator, so the deck keeps the setting in the note.
+    pub step_estimate: Option<String>,
 }
 
 /// Dynamic relaxation (the scene's `[relaxation]`).

@@ -43,6 +43,7 @@ use solver::bc::Kinematic;
 use solver::element::precision::Precision;
 use solver::element::{Formulation, HourglassForm, HourglassModulus};
 use solver::model::StepTarget;
+use solver::simulation::StepEstimate;
 use std::collections::HashMap;
 use std::fmt::Write;
 
@@ -589,6 +590,13 @@ pub fn export(scene: &Scene, opts: &ExportOptions) -> Result<Exported, String> {
             "run.subcycling = {} is palpa's own nodal-partition subcycling, not written as an LS-DYNA keyword: a $palpa comment",
             setup.subcycling
         ));
+    }
+    if setup.step_estimate != StepEstimate::Element {
+        run_note.push(format!("step_estimate = {:?}", setup.step_estimate.name()));
+        notes.push(
+            "run.step_estimate = \"global\" has no LS-DYNA keyword (LS-DYNA estimates the step element by element): a $palpa comment"
+                .into(),
+        );
     }
     if !run_note.is_empty() {
         w.palpa("run", &format!("{{ {} }}", run_note.join(", ")));

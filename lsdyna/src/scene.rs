@@ -48,7 +48,7 @@ use solver::element::precision::Precision;
 use solver::element::{BulkViscosity, Formulation, Hourglass, HourglassForm, HourglassModulus};
 use solver::mesh::Mesh;
 use solver::model::{MassScaling, StepTarget};
-use solver::simulation::DynamicRelaxation;
+use solver::simulation::{DynamicRelaxation, StepEstimate};
 use std::collections::{BTreeMap, HashMap, HashSet};
 use std::path::{Path, PathBuf};
 
@@ -1006,6 +1006,18 @@ fn build(cx: &mut Ctx, path: &Path) -> Result<SceneDef, Vec<String>> {
             1
         }
     };
+    let step_estimate = match &run_note.step_estimate {
+        None => StepEstimate::Element,
+        Some(s) => StepEstimate::parse(s).unwrap_or_else(|m| {
+            errors.push(format!("{hdr_at}: $palpa run: step_estimate: {m}"));
+            StepEstimate::Element
+        }),
+    };
+    if subcycling > 1 && step_estimate == StepEstimate::Global {
+        errors.push(format!(
+            "{hdr_at}: $palpa run: step_estimate = \"global\" cannot be combined with subcycling"
+        ));
+    }
     let hourglass_guard = run_note.max_hourglass_ratio.map(|ratio| HourglassGuard {
         ratio,
         after: run_note.hourglass_check_after,
@@ -1183,6 +1195,7 @@ fn build(cx: &mut Ctx, path: &Path) -> Result<SceneDef, Vec<String>> {
             max_steps: None,
             // LS-DYNA's own subcycling keyword is not read; palpa's is kept in its note
             subcycling,
+            step_estimate,
             hourglass_guard,
             bulk,
             damping,

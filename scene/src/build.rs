@@ -4,7 +4,7 @@ use super::contact_spec::HandScene;
 use super::def::{DtMin, Scene, SceneDef, Setup};
 use super::kinematics;
 use super::locate::Locate;
-use super::loop_settings::{max_steps, run_control, settings, subcycling};
+use super::loop_settings::{max_steps, run_control, settings, step_estimate, subcycling};
 use super::node_sets::add_node_sets;
 use super::output_plan::output_plan;
 use super::parts::part_defs;
@@ -14,6 +14,7 @@ use phantom::Phantom;
 use solver::generate::{box_mesh, BoxSpec};
 use solver::mesh::Mesh;
 use solver::renumber::{renumber, Numbering};
+use solver::simulation::StepEstimate;
 use std::path::Path;
 
 /// A scene error with its location ([`Locate::err`]).
@@ -272,6 +273,14 @@ pub fn resolve_scene(
             &"cannot be combined with [relaxation] (its damping is formed from every node's force at every step)",
         ));
     }
+    let step_estimate = step_estimate(&spec.run, at)?;
+    if subcycling > 1 && step_estimate == StepEstimate::Global {
+        return Err(at.err(
+            "run.step_estimate",
+            Some("step_estimate"),
+            &"\"global\" cannot be combined with run.subcycling (a subcycled part's elements report their step over k)",
+        ));
+    }
     // Contact exists only when the scene has indenters or hands.
     let contact = if !spec.indenters.is_empty() || !spec.hands.is_empty() {
         Some(crate::contact_build::resolve_contact(
@@ -296,6 +305,7 @@ pub fn resolve_scene(
         dt_min: spec.run.dt_min.map(|t| DtMin::Time(t.0)),
         max_steps: max_steps(&spec.run, at)?,
         subcycling,
+        step_estimate,
         hourglass_guard: st.hourglass_guard,
         bulk: st.bulk,
         damping: st.damping,

@@ -18,7 +18,9 @@ use solver::element::precision::Precision;
 use solver::element::{BulkViscosity, Formulation};
 use solver::mesh::Mesh;
 use solver::model::{MassScaling, Model, Part};
-use solver::simulation::{DynamicRelaxation, HourglassLimit, LoopSettings, Simulation};
+use solver::simulation::{
+    DynamicRelaxation, HourglassLimit, LoopSettings, Simulation, StepEstimate,
+};
 use std::path::PathBuf;
 
 /// One part: its law, the card it was built from, and its element formulation.
@@ -73,6 +75,8 @@ pub struct Setup {
     pub precision: Precision,
     /// Subcycling's largest macro ratio (1: off).
     pub subcycling: u32,
+    /// How the stable step is estimated.
+    pub step_estimate: StepEstimate,
     /// Largest step (s).
     pub dt_max: Option<f64>,
     /// Smallest step before the run stops (default: 1e-6 of the initial step).
@@ -251,6 +255,7 @@ pub fn assemble(def: SceneDef) -> Result<Scene, String> {
             after: g.after.unwrap_or(0.1 * end_time),
         }),
         subcycling: setup.subcycling,
+        step_estimate: setup.step_estimate,
     };
     let v0 = if setup.initial_velocity.is_empty() {
         None

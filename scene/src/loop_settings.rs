@@ -9,6 +9,7 @@ use solver::element::precision::Precision;
 use solver::element::BulkViscosity;
 use solver::model::MassScaling;
 use solver::simulation::DynamicRelaxation;
+use solver::simulation::StepEstimate;
 
 /// `[run]`'s end time (s), time-step factor and kernel precision, checked.
 pub(crate) fn run_control(run: &RunSpec, at: Locate) -> Result<(f64, f64, Precision), String> {
@@ -136,6 +137,15 @@ pub(crate) fn subcycling(run: &RunSpec, at: Locate) -> Result<u32, String> {
             Some("subcycling"),
             &format!("must be a power of two from 1 (off) to 1024, got {k}"),
         )),
+    }
+}
+
+/// `[run] step_estimate`: `"element"` (default) or `"global"` ([`solver::global_step`]).
+pub(crate) fn step_estimate(run: &RunSpec, at: Locate) -> Result<StepEstimate, String> {
+    match &run.step_estimate {
+        None => Ok(StepEstimate::Element),
+        Some(s) => StepEstimate::parse(s)
+            .map_err(|m| at.err("run.step_estimate", Some("step_estimate"), &m)),
     }
 }
 

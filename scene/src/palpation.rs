@@ -242,6 +242,8 @@ pub struct PalpationSetup {
     pub precision: solver::element::precision::Precision,
     /// Subcycling's largest macro ratio (`[run] subcycling`, [`solver::subcycle`]); 1 is off.
     pub subcycling: u32,
+    /// How the stable step is estimated (`[run] step_estimate`, [`solver::global_step`]).
+    pub step_estimate: solver::simulation::StepEstimate,
     /// Write VTK frames.
     pub vtk: bool,
 }
@@ -271,6 +273,7 @@ impl Default for PalpationSetup {
             fidelity: Fidelity::Standard,
             precision: Default::default(),
             subcycling: 1,
+            step_estimate: Default::default(),
             vtk: true,
         }
     }

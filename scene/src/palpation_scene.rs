@@ -19,6 +19,7 @@ use material::MaterialSpec;
 use phantom::Phantom;
 use solver::element::{HourglassForm, HourglassModulus};
 use solver::output::atomic::write_atomic;
+use solver::simulation::StepEstimate;
 use std::collections::BTreeMap;
 use std::fmt::Write;
 use std::path::Path;
@@ -203,6 +204,8 @@ impl PalpationSetup {
                 hourglass_check_after: None,
                 max_steps: None,
                 subcycling: (self.subcycling > 1).then_some(Number(self.subcycling as f64)),
+                step_estimate: (self.step_estimate != StepEstimate::Element)
+                    .then(|| self.step_estimate.name().into()),
                 title: Some(self.title.clone()),
             },
             mesh: MeshSpec {
@@ -259,10 +262,13 @@ impl PalpationSetup {
             "# A two-finger palpation of the built-in abdomen phantom, written by palpa.\n\
              # Run it again with `palpa run scene.toml --out DIR`.\n"
         );
-        let subcycling = match self.subcycling {
+        let mut subcycling = match self.subcycling {
             1 => String::new(),
             k => format!("subcycling = {k}\n"),
         };
+        if self.step_estimate != StepEstimate::Element {
+            subcycling += &format!("step_estimate = {:?}\n", self.step_estimate.name());
+        }
         let _ = writeln!(
             s,
             "[run]\ntitle = {}\nend_time = \"{} s\"\ndt_factor = {}\nprecision = {:?}\n{subcycling}",
@@ -452,7 +458,7 @@ mod tests {
 
     /// The scene file of a setup parses to the scene the solver runs, for every kind of
     /// setting: places, tumours, per-part elements, mass scaling on and off, the K/G cap,
-    /// precision, subcycling, the full phantom.
+    /// precision, subcycling, the global step estimate, the full phantom.
     #[test]
     fn the_scene_file_parses_to_the_scene_built_in_memory() {
         let mut setups = vec![PalpationSetup::default()];
@@ -494,6 +500,10 @@ mod tests {
         setups.push(fast);
         setups.push(PalpationSetup {
             subcycling: 16,
+            ..Default::default()
+        });
+        setups.push(PalpationSetup {
+            step_estimate: StepEstimate::Global,
             ..Default::default()
         });
         for e in ElementChoice::ALL {

@@ -160,6 +160,25 @@ pub struct RunSummary {
     /// Subcycling, when the run had slow elements ([`solver::subcycle`]).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub subcycling: Option<SubcyclingReport>,
+    /// The global step estimate, when the run used it ([`solver::global_step`]).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub global_step: Option<GlobalStepSummary>,
+}
+
+/// What the global step estimate did in a run.
+#[derive(Clone, Debug, Serialize)]
+pub struct GlobalStepSummary {
+    /// Estimates made.
+    pub estimates: u64,
+    /// Lanczos iterations in all.
+    pub iterations: u64,
+    /// Smallest and largest ratio of the mesh's critical step to the smallest element estimate
+    /// (same shape, without bulk viscosity).
+    pub ratio_min: f64,
+    /// See `ratio_min`.
+    pub ratio_max: f64,
+    /// Wall time of the estimates (s).
+    pub seconds: f64,
 }
 
 /// What subcycling did in a run.
@@ -720,6 +739,13 @@ fn summarise(scene: &Scene, wall: f64, status: RunStatus, rec: &Recorder) -> Run
             saved_fraction: s.saved as f64
                 / (sim.model.mesh.elements.len() as f64 * sim.step.max(1) as f64),
             slow_bound_steps: s.slow_bound_steps,
+        }),
+        global_step: sim.global_step.as_ref().map(|g| GlobalStepSummary {
+            estimates: g.report.estimates,
+            iterations: g.report.iterations,
+            ratio_min: g.report.ratio.0,
+            ratio_max: g.report.ratio.1,
+            seconds: g.report.seconds,
         }),
         dt_min: sim.dt_range.0,
         dt_max: sim.dt_range.1,

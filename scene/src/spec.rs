@@ -85,6 +85,9 @@ pub struct RunSpec {
     /// beside the flesh) may take as one; a power of two, 1 (default) is off
     /// ([`solver::subcycle`]).
     pub subcycling: Option<Number>,
+    /// How the stable step is estimated: `"element"` (default, element by element) or
+    /// `"global"` (the mesh's largest eigenvalue, [`solver::global_step`]).
+    pub step_estimate: Option<String>,
     /// A title.
     pub title: Option<String>,
 }

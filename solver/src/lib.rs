@@ -9,6 +9,7 @@ pub mod contact_stage;
 pub mod element;
 pub mod forces;
 pub mod generate;
+pub mod global_step;
 pub mod hex;
 pub mod mesh;
 pub mod mesh_io;

@@ -25,6 +25,7 @@ use crate::bc::{Constraint, Kinematic, NodalLoad, Prescribed};
 use crate::element::precision::Precision;
 use crate::element::{BulkViscosity, StepInput};
 use crate::forces::element_loop;
+use crate::global_step::{self, GlobalStep};
 use crate::model::{ElementTotals, Model, SolverError};
 use crate::nodal_update::{constrained_chunks, NodalUpdate, StepParams, StepSums, NODE_CHUNK};
 use crate::subcycle::{self, Subcycling};
@@ -198,6 +199,40 @@ pub struct LoopSettings {
     /// Subcycling: the most steps a slow part's interior may take as one
     /// ([`crate::subcycle`]); 1 (the default) is off.
     pub subcycling: u32,
+    /// How the stable step is estimated (default: element by element).
+    pub step_estimate: StepEstimate,
+}
+
+/// How the stable step is estimated.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum StepEstimate {
+    /// `f min_e kappa L_e / c_e`, element by element (LS-DYNA's and OpenRadioss's default).
+    #[default]
+    Element,
+    /// The mesh's largest eigenvalue by Lanczos iteration, renewed during the run
+    /// ([`crate::global_step`]); never below the element estimate.
+    Global,
+}
+
+impl StepEstimate {
+    /// From `"element"` or `"global"`; the error names the accepted values.
+    pub fn parse(s: &str) -> Result<StepEstimate, String> {
+        match s {
+            "element" => Ok(StepEstimate::Element),
+            "global" => Ok(StepEstimate::Global),
+            _ => Err(format!(
+                "unknown step estimate {s:?}: expected \"element\" (element by element) or \"global\" (the mesh's largest eigenvalue)"
+            )),
+        }
+    }
+
+    /// The name [`StepEstimate::parse`] reads.
+    pub fn name(self) -> &'static str {
+        match self {
+            StepEstimate::Element => "element",
+            StepEstimate::Global => "global",
+        }
+    }
 }
 
 /// The hourglass guard: a run whose hourglass energy exceeds `ratio` x internal energy at any
@@ -225,6 +260,7 @@ impl Default for LoopSettings {
             hourglass_limit: None,
             precision: Precision::F64,
             subcycling: 1,
+            step_estimate: StepEstimate::Element,
         }
     }
 }
@@ -286,6 +322,8 @@ pub struct Simulation {
     pub subcycling: Option<Subcycling>,
     /// Why a run that asked for subcycling has none.
     pub subcycling_off: Option<String>,
+    /// The global step estimate, when `settings.step_estimate` asks for it.
+    pub global_step: Option<GlobalStep>,
     totals: ElementTotals,
     initialised: bool,
     hg_dissipated: f64,
@@ -323,6 +361,7 @@ enum Stage {
     Contact,
     Update,
     MassScaling,
+    StepEstimate,
 }
 
 impl Simulation {
@@ -388,6 +427,7 @@ impl Simulation {
             erosion: Erosion::default(),
             subcycling: None,
             subcycling_off: None,
+            global_step: None,
             totals: ElementTotals::default(),
             initialised: false,
             hg_dissipated: 0.0,
@@ -420,6 +460,9 @@ impl Simulation {
         }
         if self.subcycling.is_some() {
             s.push("subcycling".into());
+        }
+        if self.global_step.is_some() {
+            s.push("global step estimate".into());
         }
         if self.settings.damping.is_some() {
             s.push("mass-proportional damping".into());
@@ -516,6 +559,9 @@ impl Simulation {
         } else {
             self.dt_next = self.settings.dt_factor * tot.dt_min;
             self.dt_element = tot.dt_elem;
+            if self.global_step.is_some() {
+                self.time_stage(Stage::StepEstimate as usize, |s| s.global_step_choice());
+            }
         }
         Ok(())
     }
@@ -695,9 +741,42 @@ impl Simulation {
             if self.settings.subcycling > 1 {
                 self.partition_for_subcycling()?;
             }
+            if self.settings.step_estimate == StepEstimate::Global {
+                self.start_global_step()?;
+            }
             self.internal_forces(self.stress.is_some())?;
             self.initialised = true;
         }
+        Ok(())
+    }
+
+    /// Lengthen the next step by the global estimate ([`crate::global_step`]), renewing it
+    /// when due; never below the element estimate already in `dt_next`.
+    fn global_step_choice(&mut self) {
+        let Some(g) = &mut self.global_step else {
+            return;
+        };
+        let fall = g.fall(&self.model);
+        let fall = if g.due(self.step, fall) {
+            g.estimate(&self.model, &self.u, &self.model.mass, self.step);
+            g.fall(&self.model)
+        } else {
+            fall
+        };
+        self.dt_next = self.dt_next.max(self.settings.dt_factor * g.step(fall));
+    }
+
+    /// Start the global step estimate ([`crate::global_step`]).
+    fn start_global_step(&mut self) -> Result<(), SolverError> {
+        if self.subcycling.is_some() {
+            return Err(SolverError::Invalid(
+                "the global step estimate cannot be combined with subcycling (the slow parts' \
+                 elements report their step over k): set run.step_estimate = \"element\" or \
+                 run.subcycling = 1"
+                    .into(),
+            ));
+        }
+        self.global_step = Some(GlobalStep::new(&self.model, global_step::DEFAULT_INTERVAL));
         Ok(())
     }
 
@@ -1086,6 +1165,7 @@ fn stage_timers() -> Vec<StageTime> {
         "contact",
         "update",
         "mass scaling",
+        "global step estimate",
     ]
     .into_iter()
     .map(|name| StageTime {

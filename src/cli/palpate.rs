@@ -89,6 +89,12 @@ pub struct PalpateArgs {
     /// default, is off). Its measured time and error: docs/performance.md, "Subcycling".
     #[arg(long, default_value_t = 1)]
     pub subcycle: u32,
+    /// How the stable step is estimated: element (element by element, as LS-DYNA) or global
+    /// (the mesh's largest eigenvalue by Lanczos iteration, as Abaqus/Explicit; never below the
+    /// element estimate). Its measured time and error: docs/performance.md, "The global step
+    /// estimate".
+    #[arg(long, default_value = "element")]
+    pub step_estimate: String,
     /// Skip the VTK frames.
     #[arg(long)]
     pub no_vtk: bool,
@@ -170,6 +176,15 @@ impl PalpateArgs {
             ));
         }
         s.subcycling = self.subcycle;
+        s.step_estimate = solver::simulation::StepEstimate::parse(&self.step_estimate)
+            .map_err(|e| format!("--step-estimate: {e}"))?;
+        if s.subcycling > 1 && s.step_estimate != solver::simulation::StepEstimate::Element {
+            return Err(
+                "--step-estimate global cannot be combined with --subcycle (a subcycled part's \
+                 elements report their step over k)"
+                    .into(),
+            );
+        }
         s.vtk = !self.no_vtk;
         s.title = match &s.place {
             Place::Named(n) => format!("palpation at {n}"),

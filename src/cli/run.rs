@@ -67,6 +67,12 @@ pub fn print_summary(s: &RunSummary) {
             100.0 * sc.saved_fraction
         );
     }
+    if let Some(g) = &s.global_step {
+        println!(
+            "  step estimate: global, {} estimates ({} Lanczos iterations, {:.2} s); the mesh's critical step is {:.2}-{:.2} times the smallest element estimate",
+            g.estimates, g.iterations, g.seconds, g.ratio_min, g.ratio_max
+        );
+    }
     println!("  where the time went:");
     for st in &s.stage_times {
         println!(
