@@ -23,7 +23,7 @@
 //! Cases: the paper's flesh (K/G = 5e4) under 30 % compression between glued plates (one-point
 //! and F-bar); the paper's liver law taken through stretches 0.5-1.6; a palpation-like
 //! indentation of a flesh block at 1 m/s and 5 m/s by a rigid spherical finger in penalty
-//! contact; the paper's ribs yielding in three-point bending; an element whose corner is
+//! contact (also on the global step estimate, [`solver::global_step`]); the paper's ribs yielding in three-point bending; an element whose corner is
 //! driven 2 edge lengths through the opposite face; a finger smaller than an element; and
 //! the liver's negative instantaneous Poisson ratio (with the Prony series on the deviatoric
 //! strain, K_inst = K = 32 kPa < 2/3 G_inst, nu_inst = (3K - 2G)/(2(3K + G)) < 0).
@@ -587,6 +587,21 @@ pub fn run() -> CaseOutput {
                 &format!("palpation-{v}-{}", label.len()),
             );
         }
+        // the same press with F-bar elements (the one-point ones stop on their hourglass
+        // modes) on the mesh's own critical step (solver::global_step)
+        let (label, element) = SCENE_ELEMENTS[1];
+        push_scene(
+            &mut out,
+            &format!(
+                "palpation: finger R 7.5 mm, 6 mm at {v} m/s (flesh), {label}, global step estimate"
+            ),
+            &finger_scene(16, 0.0075, &motion, end, element).replacen(
+                "[run]\n",
+                "[run]\nstep_estimate = \"global\"\n",
+                1,
+            ),
+            &format!("palpation-{v}-global"),
+        );
     }
     match ribs_bending() {
         Ok((r, eps)) => {
