@@ -69,8 +69,9 @@ fn a_regular_block_matches_the_eigenvalue_study() {
     assert!((ratio - 0.855).abs() < 0.0015, "{ratio}");
 }
 
-/// `2 / sqrt(max eig(M^-1 K))` with `K` assembled densely from each element's centre gradients
-/// and volume (`hex::element_geometry`) and the model's lumped masses (s).
+/// `2 / sqrt(max eig(M^-1 K))` with `K` assembled densely from each element's mean gradients
+/// and volume (`hex::element_geometry`: the one-point element's) and the model's lumped masses
+/// (s).
 fn dense_critical_step(scene: &Scene) -> f64 {
     let model = &scene.sim.model;
     let mesh = &model.mesh;
@@ -82,13 +83,7 @@ fn dense_critical_step(scene: &Scene) -> f64 {
     for conn in &mesh.elements {
         let x: [[f64; 3]; 8] = std::array::from_fn(|a| mesh.nodes[conn[a] as usize]);
         let g = element_geometry(&x).unwrap();
-        let b = |a: usize| {
-            Vector3::new(
-                g.centre_grad[0][a],
-                g.centre_grad[1][a],
-                g.centre_grad[2][a],
-            )
-        };
+        let b = |a: usize| Vector3::new(g.mean_grad[0][a], g.mean_grad[1][a], g.mean_grad[2][a]);
         for a in 0..8 {
             for c in 0..8 {
                 let (ba, bc) = (b(a), b(c));

@@ -591,6 +591,9 @@ fn book_lanes<L: Law, R: Real>(
                 let e = fault_error(fault, fault_v[q], l.name());
                 acc.error = Some((g.elements[le], e.to_string()));
             }
+            if g.record_dt {
+                acc.dts.push(f64::INFINITY);
+            }
             continue;
         }
         add[q] = true;
@@ -600,6 +603,12 @@ fn book_lanes<L: Law, R: Real>(
             let r = g.dt_floor / dt;
             acc.rescale.push((le as u32, s_l[q] * r * r));
             dt = g.dt_floor;
+        }
+        if let Some(r) = g.dt_reference.get(le) {
+            acc.rise = acc.rise.max(r / dt);
+        }
+        if g.record_dt {
+            acc.dts.push(dt);
         }
         let (hs, hp) = (hs_l[q], hp_l[q]);
         let failed = o.failed.lane(q);

@@ -13,16 +13,22 @@
 //! `2 / omega_max` is 1.57 times the smallest element estimate.
 //!
 //! ## The operator
-//! The one-point element's linear stiffness at the current shape, with each part's initial
-//! moduli: per element `K_e = V B^T D B` with `B` the centre gradients of the current shape, `V`
-//! its exact volume, `D` isotropic with the P-wave modulus `rho c0^2` and the initial shear
-//! modulus (the moduli of the element estimate); `M` the lumped nodal masses with mass scaling;
-//! eroded elements left out. Constraints are left out too: they can only lower `omega_max`
-//! (Cauchy interlacing), so the estimate errs safe. The hourglass forms add no stiffness here:
-//! the viscous form (the default) has none; the stiffness and physical forms add stiffness of the
-//! order of the shear modulus to modes the mean strain does not see, far below the dilatational
-//! modes of a nearly incompressible tissue (the estimate is meant for those; for a compressible
-//! solid it gains little anyway).
+//! The one-point element's linear stiffness at the current state, as the element loop forms
+//! it: per element `K_e = V B^T D B` with `B = F^-T b0` the reference mean gradients pushed
+//! forward by the element's mean deformation gradient, `V = J V0`, and `D` isotropic; `M` the
+//! lumped nodal masses after mass scaling. (The centre gradients of the current shape are not
+//! the element loop's: on a crushed, hourglassed element they are far softer, and a run on
+//! them went unstable: the 5 mm palpation without mass scaling at 22 ms.) `D` holds the part's initial
+//! moduli times `phi = (c / c0)^2`, with `c = L sqrt(s) / dt_e` the wave speed that the element
+//! loop's own step `dt_e` for that element implies (`L = V / A_max`, `s` its density scale):
+//! the operator's element-by-element estimate is then exactly the element loop's, with the
+//! current tangent stiffness of the law (a crushed rubber element stiffens) and the bulk
+//! viscosity counted in as stiffness, which errs safe. Eroded elements are left out.
+//! Constraints are left out too: they can only lower `omega_max` (Cauchy interlacing). The
+//! hourglass forms add no stiffness here: the viscous form (the default) has none; the
+//! stiffness and physical forms add stiffness of the order of the shear modulus to modes the
+//! mean strain does not see, far below the dilatational modes of a nearly incompressible
+//! tissue (the estimate is meant for those; for a compressible solid it gains little anyway).
 //!
 //! ## The iteration
 //! Lanczos on `A = M^-1/2 K M^-1/2` (symmetric), without reorthogonalisation (lost orthogonality
@@ -35,16 +41,18 @@
 //! thread count.
 //!
 //! ## The step
-//! `dt = f G s(t)`, with `G = 2 / sqrt(lambda)` from the last estimate and
-//! `s(t) = min(1, min_c m_c(t) / m_c^0)`: `m_c(t)` is chunk `c`'s element minimum in this step's
-//! element loop (current shapes, wave speeds, density scales and bulk-viscous term `Q`), `m_c^0`
-//! the same on the estimate's shape without `Q`. An element crushed between two estimates
-//! therefore lowers the step at once, and the bulk viscosity lowers it as it lowers the
-//! element estimate (LS-DYNA's `L / (Q + sqrt(Q^2 + c^2))`; the linear term alone gives
-//! `s` = 0.94). The estimate is renewed every `interval` steps, and early when `s` has fallen
-//! by `RENEW_FALL` since just after the last estimate (at most every [`MIN_SPACING`] steps): a
-//! crushed element that turns out to be surrounded by heavier ones then gets its step back.
-//! The step never goes below the element estimate `f min_e dt_e`.
+//! `dt = f G s(t)`, with `G = 2 / sqrt(lambda)` from the last estimate and `s(t)` the smallest
+//! ratio, at most 1, of an element's step in this step's element loop to its step at the last
+//! estimate (`Group::dt_reference`, compared element by element in the loop,
+//! `ChunkOut::rise`). An element's stiffness over its mass goes as `1 / dt_e^2`; were every
+//! element's `K_e` at most `1 / s^2` times its value at the estimate, the Rayleigh quotient
+//! would bound the mesh's `lambda` by `lambda_0 / s^2` (the shapes change too, so this is the
+//! scaling rather than a bound). An element crushed between two estimates, or stiffening,
+//! therefore lowers the step at once.
+//! The estimate is renewed every `interval` steps, and early when `s` falls below
+//! `1 - RENEW_FALL` (at most every [`MIN_SPACING`] steps); the loop before an estimate records
+//! every element's step (`Group::record_dt`). The step never goes below the element estimate
+//! `f min_e dt_e`.
 use crate::model::Model;
 use rayon::prelude::*;
 
@@ -54,8 +62,8 @@ pub const TOLERANCE: f64 = 1e-3;
 pub const MIN_ITERATIONS: usize = 10;
 /// Most iterations of one estimate.
 pub const MAX_ITERATIONS: usize = 150;
-/// A fall of some chunk's element minimum, relative to the last estimate, that renews the
-/// estimate before its interval is out.
+/// A fall of some element's step, relative to the last estimate, that renews the estimate
+/// before its interval is out.
 pub const RENEW_FALL: f64 = 0.1;
 /// Default interval between two estimates (steps).
 pub const DEFAULT_INTERVAL: u64 = 500;
@@ -67,7 +75,7 @@ pub const MIN_SPACING: u64 = 50;
 /// threads).
 const CHUNK: usize = 1024;
 
-/// One element of the operator: nodes, volume (m^3), centre gradients (1/m), moduli (Pa).
+/// One element of the operator: nodes, volume (m^3), gradients `F^-T b0` (1/m), moduli (Pa).
 #[derive(Clone, Copy)]
 struct OpElement {
     conn: [u32; 8],
@@ -97,12 +105,10 @@ pub struct GlobalStep {
     interval: u64,
     /// The last estimate's critical step `2 / sqrt(lambda)` (s).
     global: f64,
-    /// Every chunk's element minimum at the last estimate, groups and chunks in order.
-    chunk_dt: Vec<f64>,
     /// Step of the last estimate.
     last_step: u64,
-    /// `s` just after the last estimate (the bulk viscosity of that step in it).
-    fall_after: f64,
+    /// `s` of the last element loop ([`GlobalStep::fall`]).
+    pub fall: f64,
     /// What the run reports.
     pub report: GlobalStepReport,
     /// The next start vector, per node.
@@ -145,9 +151,8 @@ impl GlobalStep {
         GlobalStep {
             interval: interval.max(1),
             global: 0.0,
-            chunk_dt: Vec::new(),
             last_step: 0,
-            fall_after: 1.0,
+            fall: 1.0,
             report: GlobalStepReport {
                 ratio: (f64::INFINITY, 0.0),
                 ..Default::default()
@@ -159,25 +164,28 @@ impl GlobalStep {
         }
     }
 
-    /// `s(t)`: the smallest ratio of a chunk's element minimum now to the same at the last
-    /// estimate (1 when none fell, or before the first estimate).
-    pub fn fall(&self, model: &Model) -> f64 {
-        let mut s = 1.0f64;
-        for (now, then) in chunk_minima(model).zip(&self.chunk_dt) {
-            if now.is_finite() && then.is_finite() && *then > 0.0 {
-                s = s.min(now / then);
-            }
+    /// `s(t)` of the element loop that has just run: the smallest ratio of an element's step
+    /// now to its step at the last estimate, at most 1 (1 before the first estimate).
+    pub fn fall(model: &Model) -> f64 {
+        let rise = model
+            .groups
+            .iter()
+            .flat_map(|g| g.chunks.iter().map(|c| c.rise))
+            .fold(0.0, f64::max);
+        if rise > 1.0 {
+            1.0 / rise
+        } else {
+            1.0
         }
-        s
     }
 
-    /// Whether the estimate is due at `step` with the fall `s` ([`GlobalStep::fall`]): its
-    /// interval is out, or `s` fell by `RENEW_FALL` since just after the last estimate and
-    /// [`MIN_SPACING`] steps have passed.
+    /// Whether the next element loop should record the elements' steps for an estimate at
+    /// `step`, the last loop's fall being `s`: the first estimate, the interval out, or `s`
+    /// below `1 - RENEW_FALL` with [`MIN_SPACING`] steps passed.
     pub fn due(&self, step: u64, s: f64) -> bool {
         self.report.estimates == 0
             || step >= self.last_step + self.interval
-            || (s < (1.0 - RENEW_FALL) * self.fall_after && step >= self.last_step + MIN_SPACING)
+            || (s < 1.0 - RENEW_FALL && step >= self.last_step + MIN_SPACING)
     }
 
     /// The last estimate's critical step of the mesh `G = 2 / sqrt(lambda)` (s; 0 before the
@@ -191,30 +199,28 @@ impl GlobalStep {
         self.global * s.min(1.0)
     }
 
-    /// Estimate at displacements `u` and masses `mass` (the model's element loop has just run:
-    /// its chunk minima are this state's).
-    pub fn estimate(&mut self, model: &Model, u: &[[f64; 3]], mass: &[f64], step: u64) {
+    /// Estimate at displacements `u` and masses `mass`, from the element loop that has just
+    /// run with every group's `record_dt` set: its steps become the groups' `dt_reference`.
+    pub fn estimate(&mut self, model: &mut Model, u: &[[f64; 3]], step: u64) {
         let t0 = std::time::Instant::now();
-        let (ops, elem_dt) = operator(model, u);
-        let w: Vec<f64> = mass.iter().map(|m| 1.0 / m.sqrt()).collect();
-        let (lambda, it) = self.lanczos(&ops, &w);
-        self.global = 2.0 / lambda.sqrt();
-        // each chunk's element minimum on this shape without bulk viscosity, and the model's
-        // element estimate (with kappa) for the report
-        self.chunk_dt.clear();
+        let mut dts = vec![f64::INFINITY; model.mesh.elements.len()];
         let mut element = f64::INFINITY;
-        for g in &model.groups {
-            for ch in g.elements.chunks(crate::model::CHUNK) {
-                let m = ch
-                    .iter()
-                    .map(|&e| elem_dt[e as usize])
-                    .fold(f64::INFINITY, f64::min);
-                self.chunk_dt.push(m);
-                element = element.min(g.dt_kappa * m);
+        for g in model.groups.iter_mut() {
+            g.record_dt = false;
+            g.dt_reference.clear();
+            for ch in &mut g.chunks {
+                g.dt_reference.append(&mut ch.dts);
+            }
+            for (&e, &dt) in g.elements.iter().zip(&g.dt_reference) {
+                dts[e as usize] = dt;
+                element = element.min(g.dt_kappa * dt);
             }
         }
+        let ops = operator(model, u, &dts);
+        let w: Vec<f64> = model.mass.iter().map(|m| 1.0 / m.sqrt()).collect();
+        let (lambda, it) = self.lanczos(&ops, &w);
+        self.global = 2.0 / lambda.sqrt();
         self.last_step = step;
-        self.fall_after = self.fall(model);
         let ratio = self.global / element;
         let r = &mut self.report;
         r.estimates += 1;
@@ -280,13 +286,95 @@ impl GlobalStep {
     }
 }
 
-/// Every chunk's element minimum (s; before each group's `dt_kappa`, which cancels in ratios),
-/// groups and chunks in order.
-fn chunk_minima(model: &Model) -> impl Iterator<Item = f64> + '_ {
-    model
-        .groups
+/// The operator's elements at displacements `u`, with `dts` each element's step from the
+/// element loop of this state (global id; before `kappa`, with its density scale, current wave
+/// speed and bulk viscosity; infinite for an eroded or faulted element, which adds no
+/// stiffness). The gradients are the element loop's own: the reference mean gradients `b0`
+/// pushed forward by the element's mean deformation gradient, `b = F^-T b0`, on the volume
+/// `V = J V0` (a crushed element's centre gradients can differ from them several times over).
+/// Each element's moduli are its part's initial ones times `phi = (c / c0)^2`, the wave speed
+/// `c = L sqrt(s) / dt` its step implies (`L = V / A_max`, `s` its density scale), so that the
+/// operator's own element-by-element estimate is the element loop's.
+fn operator(model: &Model, u: &[[f64; 3]], dts: &[f64]) -> Vec<OpElement> {
+    let mesh = &model.mesh;
+    let consts: Vec<(f64, f64, f64)> = model
+        .parts
         .iter()
-        .flat_map(|g| g.chunks.iter().map(|c| c.totals.dt_min))
+        .map(|p| {
+            let law = &p.material;
+            let c0 = law.initial_wave_speed();
+            let m = law.density() * c0 * c0;
+            let mu = law.initial_shear_modulus().max(0.0);
+            (c0, (m - 2.0 * mu).max(0.0), mu)
+        })
+        .collect();
+    let mut ops = vec![
+        OpElement {
+            conn: [0; 8],
+            volume: 0.0,
+            grad: [[0.0; 8]; 3],
+            lambda: 0.0,
+            mu: 0.0,
+        };
+        mesh.elements.len()
+    ];
+    for g in &model.groups {
+        let (c0, lambda, mu) = consts[g.part];
+        let built: Vec<OpElement> = (0..g.elements.len())
+            .into_par_iter()
+            .with_min_len(CHUNK)
+            .map(|le| {
+                let e = g.elements[le] as usize;
+                let conn = g.conn[le];
+                let mut op = OpElement {
+                    conn,
+                    volume: 0.0,
+                    grad: [[0.0; 8]; 3],
+                    lambda: 0.0,
+                    mu: 0.0,
+                };
+                let dt = dts[e];
+                if !(dt.is_finite() && dt > 0.0) {
+                    return op;
+                }
+                let (bi, q) = (le / material::real::LANES, le % material::real::LANES);
+                let b0: [[f64; 8]; 3] = std::array::from_fn(|i| {
+                    std::array::from_fn(|a| g.grad[bi][i][a].to_array()[q])
+                });
+                let mut f = nalgebra::Matrix3::<f64>::identity();
+                let mut x = [[0.0; 8]; 3];
+                for a in 0..8 {
+                    let n = conn[a] as usize;
+                    for i in 0..3 {
+                        x[i][a] = mesh.nodes[n][i] + u[n][i];
+                        for k in 0..3 {
+                            f[(i, k)] += u[n][i] * b0[k][a];
+                        }
+                    }
+                }
+                let j = f.determinant();
+                let Some(finv) = f.try_inverse().filter(|_| j > 0.0) else {
+                    return op;
+                };
+                for a in 0..8 {
+                    for i in 0..3 {
+                        op.grad[i][a] = (0..3).map(|k| finv[(k, i)] * b0[k][a]).sum();
+                    }
+                }
+                let s = g.density_scale.get(le).copied().unwrap_or(1.0);
+                op.volume = j * g.vol0[le];
+                let initial = op.volume / crate::element::max_face_area(&x) / c0 * s.sqrt();
+                let phi = (initial / dt).powi(2);
+                op.lambda = phi * lambda;
+                op.mu = phi * mu;
+                op
+            })
+            .collect();
+        for (le, op) in built.into_iter().enumerate() {
+            ops[g.elements[le] as usize] = op;
+        }
+    }
+    ops
 }
 
 /// `y += a x`.
@@ -398,89 +486,4 @@ fn apply(
             *f = [f[0] * w[n], f[1] * w[n], f[2] * w[n]];
         });
     y
-}
-
-/// The operator's elements at displacements `u`, and each element's estimate `L / c` with
-/// its density scale, before the part's `kappa` (s; infinite for an element left out). An
-/// element whose centre Jacobian is not positive adds no stiffness (the element loop stops
-/// such a run).
-fn operator(model: &Model, u: &[[f64; 3]]) -> (Vec<OpElement>, Vec<f64>) {
-    let mesh = &model.mesh;
-    let consts: Vec<(f64, f64, f64)> = model
-        .parts
-        .iter()
-        .map(|p| {
-            let law = &p.material;
-            let c0 = law.initial_wave_speed();
-            let m = law.density() * c0 * c0;
-            let mu = law.initial_shear_modulus().max(0.0);
-            (c0, (m - 2.0 * mu).max(0.0), mu)
-        })
-        .collect();
-    let none = |conn: &[u32; 8]| {
-        let op = OpElement {
-            conn: *conn,
-            volume: 0.0,
-            grad: [[0.0; 8]; 3],
-            lambda: 0.0,
-            mu: 0.0,
-        };
-        (op, f64::INFINITY)
-    };
-    // mass scaling's density scale and erosion, per element
-    let mut scale = vec![1.0; mesh.elements.len()];
-    for g in &model.groups {
-        for (le, &e) in g.elements.iter().enumerate() {
-            scale[e as usize] = match g.eroded.get(le) {
-                Some(true) => 0.0,
-                _ => g.density_scale.get(le).copied().unwrap_or(1.0),
-            };
-        }
-    }
-    let per: Vec<(OpElement, f64)> = mesh
-        .elements
-        .par_iter()
-        .with_min_len(CHUNK)
-        .zip(mesh.element_part.par_iter())
-        .zip(scale.par_iter())
-        .map(|((conn, &part), &scale)| {
-            let (c0, lambda, mu) = consts[part as usize];
-            if scale == 0.0 {
-                return none(conn);
-            }
-            let x: [[f64; 3]; 8] = std::array::from_fn(|a| {
-                let (p, d) = (mesh.nodes[conn[a] as usize], u[conn[a] as usize]);
-                [p[0] + d[0], p[1] + d[1], p[2] + d[2]]
-            });
-            let j = crate::hex::jacobian(&x, [0.0; 3]);
-            let det = j.determinant();
-            let Some(jinv) = j.try_inverse().filter(|_| det > 0.0) else {
-                return none(conn);
-            };
-            let jit = jinv.transpose();
-            let d = crate::hex::dn_dxi([0.0; 3]);
-            let mut grad = [[0.0; 8]; 3];
-            for a in 0..8 {
-                let g = jit * nalgebra::Vector3::new(d[a][0], d[a][1], d[a][2]);
-                for i in 0..3 {
-                    grad[i][a] = g[i];
-                }
-            }
-            // the exact volume (det J is of degree 2 in each coordinate: 2x2x2 Gauss is exact)
-            let volume: f64 = crate::hex::gauss_points()
-                .iter()
-                .map(|p| crate::hex::jacobian(&x, *p).determinant())
-                .sum();
-            let dt = crate::model::initial_element_dt(&x, volume, c0) * scale.sqrt();
-            let op = OpElement {
-                conn: *conn,
-                volume,
-                grad,
-                lambda,
-                mu,
-            };
-            (op, dt)
-        })
-        .collect();
-    per.into_iter().unzip()
 }

@@ -191,6 +191,12 @@ pub struct ChunkOut {
     /// Run-time mass scaling: elements (group-local index) whose step fell below the group's
     /// floor this step, with the density scale that brings it back to the floor.
     pub rescale: Vec<(u32, f64)>,
+    /// The global step estimate ([`crate::global_step`]): the largest ratio of an element's
+    /// step at the last estimate (`Group::dt_reference`) to its step now (0 without one).
+    pub rise: f64,
+    /// Every element's step (before `dt_kappa`; infinite for an eroded or faulted one), in
+    /// local order, when the group's `record_dt` asked for it.
+    pub dts: Vec<f64>,
 }
 
 /// A group of elements with one law and one formulation (struct of arrays).
@@ -271,6 +277,12 @@ pub struct Group {
     /// The reference data in `f32` lanes, built the first time an `f32` run evaluates the
     /// group ([`crate::element::precision`]).
     pub narrow: Option<Box<NarrowRef>>,
+    /// The global step estimate ([`crate::global_step`]): each element's step at the last
+    /// estimate (local order; empty without one). The element loop reports the largest
+    /// ratio of it to the element's step now ([`ChunkOut::rise`]).
+    pub dt_reference: Vec<f64>,
+    /// Make the next element loop record every element's step ([`ChunkOut::dts`]).
+    pub record_dt: bool,
 }
 
 /// A group's hourglass energy: the stiffness form's stored energy and the viscous form's power
@@ -982,6 +994,8 @@ fn empty_group(part: usize, elements: Vec<u32>, stride: usize) -> Group {
         step_ratio: 1,
         held: ElementTotals::EMPTY,
         evaluated: false,
+        dt_reference: Vec::new(),
+        record_dt: false,
     }
 }
 

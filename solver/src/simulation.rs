@@ -511,6 +511,13 @@ impl Simulation {
             precision: self.settings.precision,
             macro_dt,
         };
+        if let Some(g) = &self.global_step {
+            if g.due(self.step, g.fall) {
+                for gr in self.model.groups.iter_mut() {
+                    gr.record_dt = true;
+                }
+            }
+        }
         let t0 = Instant::now();
         let stress = if want_stress || slow_stress {
             self.stress.as_deref_mut()
@@ -756,14 +763,14 @@ impl Simulation {
         let Some(g) = &mut self.global_step else {
             return;
         };
-        let fall = g.fall(&self.model);
-        let fall = if g.due(self.step, fall) {
-            g.estimate(&self.model, &self.u, &self.model.mass, self.step);
-            g.fall(&self.model)
+        // the loop that has just run recorded every element's step when an estimate was due
+        if self.model.groups.iter().any(|gr| gr.record_dt) {
+            g.estimate(&mut self.model, &self.u, self.step);
+            g.fall = 1.0;
         } else {
-            fall
-        };
-        self.dt_next = self.dt_next.max(self.settings.dt_factor * g.step(fall));
+            g.fall = GlobalStep::fall(&self.model);
+        }
+        self.dt_next = self.dt_next.max(self.settings.dt_factor * g.step(g.fall));
     }
 
     /// Start the global step estimate ([`crate::global_step`]).
