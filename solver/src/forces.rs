@@ -605,7 +605,10 @@ fn book_lanes<L: Law, R: Real>(
             dt = g.dt_floor;
         }
         if let Some(r) = g.dt_reference.get(le) {
-            acc.rise = acc.rise.max(r / dt);
+            if r / dt > acc.rise {
+                acc.rise = r / dt;
+                acc.rise_elem = g.elements[le];
+            }
         }
         if g.record_dt {
             acc.dts.push(dt);

@@ -194,6 +194,8 @@ pub struct ChunkOut {
     /// The global step estimate ([`crate::global_step`]): the largest ratio of an element's
     /// step at the last estimate (`Group::dt_reference`) to its step now (0 without one).
     pub rise: f64,
+    /// The element (global id) of `rise`.
+    pub rise_elem: u32,
     /// Every element's step (before `dt_kappa`; infinite for an eroded or faulted one), in
     /// local order, when the group's `record_dt` asked for it.
     pub dts: Vec<f64>,

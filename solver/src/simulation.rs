@@ -23,7 +23,7 @@
 
 use crate::bc::{Constraint, Kinematic, NodalLoad, Prescribed};
 use crate::element::precision::Precision;
-use crate::element::{BulkViscosity, StepInput};
+use crate::element::{BulkViscosity, Formulation, StepInput};
 use crate::forces::element_loop;
 use crate::global_step::{self, GlobalStep};
 use crate::model::{ElementTotals, Model, SolverError};
@@ -783,6 +783,26 @@ impl Simulation {
                     .into(),
             ));
         }
+        if self.settings.dt_factor > DEFAULT_DT_FACTOR {
+            // the contact stage's bound assumes the body at most 0.9 of its critical step, and
+            // the global estimate leaves no slack beyond the factor
+            return Err(SolverError::Invalid(format!(
+                "run.step_estimate = \"global\" needs run.dt_factor <= {DEFAULT_DT_FACTOR}, got {}",
+                self.settings.dt_factor
+            )));
+        }
+        if let Some(g) = self
+            .model
+            .groups
+            .iter()
+            .find(|g| self.model.parts[g.part].formulation == Formulation::Full { fbar: false })
+        {
+            return Err(SolverError::Invalid(format!(
+                "run.step_estimate = \"global\" does not hold fully integrated elements without F-bar \
+                 (part `{}`): use formulation = \"full_fbar\" or run.step_estimate = \"element\"",
+                self.model.parts[g.part].name
+            )));
+        }
         self.global_step = Some(GlobalStep::new(&self.model, global_step::DEFAULT_INTERVAL));
         Ok(())
     }
@@ -945,14 +965,19 @@ impl Simulation {
                 "the hourglass dissipation outran the work it absorbs: lower `run.dt_factor`, or use stiffness or physical hourglass control"
             };
             return Err(SolverError::Unstable(format!(
-                "numerical instability at t = {:.6} ms: the internal energy became negative ({:.4e} J; hourglass {:.4e} J, bulk viscosity {:.4e} J, external work {:.4e} J). The step was set by element {el} (part {}), `run.dt_factor` {}; {advice}",
+                "numerical instability at t = {:.6} ms: the internal energy became negative ({:.4e} J; hourglass {:.4e} J, bulk viscosity {:.4e} J, external work {:.4e} J). The step was set by element {el} (part {}), `run.dt_factor` {}; {advice}{}",
                 self.time * 1e3,
                 e.internal,
                 e.hourglass,
                 e.bulk_viscous,
                 e.external,
                 self.part_of(el),
-                self.settings.dt_factor
+                self.settings.dt_factor,
+                if self.global_step.is_some() {
+                    "; the step came from the global estimate: try run.step_estimate = \"element\" (palpate --step-estimate element)"
+                } else {
+                    ""
+                }
             )));
         }
         Ok(())
