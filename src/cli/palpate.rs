@@ -15,6 +15,7 @@ use super::units;
 use scene::palpation::{read_probe, ElementChoice, Fidelity, PalpationSetup, Place, ProbeSamples};
 use solver::output::atomic::write_atomic;
 use solver::output::history::{column, read_history};
+use solver::simulation::StepEstimate;
 use std::fmt::Write;
 use std::path::Path;
 use std::time::Instant;
@@ -89,12 +90,13 @@ pub struct PalpateArgs {
     /// default, is off). Its measured time and error: docs/performance.md, "Subcycling".
     #[arg(long, default_value_t = 1)]
     pub subcycle: u32,
-    /// How the stable step is estimated: element (element by element, as LS-DYNA) or global
-    /// (the mesh's largest eigenvalue by Lanczos iteration, as Abaqus/Explicit; never below the
-    /// element estimate). Its measured time and error: docs/performance.md, "The global step
-    /// estimate".
-    #[arg(long, default_value = "element")]
-    pub step_estimate: String,
+    /// How the stable step is estimated: global (the mesh's largest eigenvalue by Lanczos
+    /// iteration, as Abaqus/Explicit; never below the element estimate) or element (element by
+    /// element, as LS-DYNA, and as scenes and campaigns do by default). Default: global, except
+    /// with --fidelity fast (whose error budget was measured element by element) and
+    /// --subcycle. Its measured time and error: docs/performance.md, "The global step estimate".
+    #[arg(long)]
+    pub step_estimate: Option<String>,
     /// Skip the VTK frames.
     #[arg(long)]
     pub no_vtk: bool,
@@ -176,9 +178,12 @@ impl PalpateArgs {
             ));
         }
         s.subcycling = self.subcycle;
-        s.step_estimate = solver::simulation::StepEstimate::parse(&self.step_estimate)
-            .map_err(|e| format!("--step-estimate: {e}"))?;
-        if s.subcycling > 1 && s.step_estimate != solver::simulation::StepEstimate::Element {
+        s.step_estimate = match &self.step_estimate {
+            Some(v) => StepEstimate::parse(v).map_err(|e| format!("--step-estimate: {e}"))?,
+            None if fidelity == Fidelity::Fast || s.subcycling > 1 => StepEstimate::Element,
+            None => StepEstimate::Global,
+        };
+        if s.subcycling > 1 && s.step_estimate != StepEstimate::Element {
             return Err(
                 "--step-estimate global cannot be combined with --subcycle (a subcycled part's \
                  elements report their step over k)"
