@@ -295,14 +295,18 @@ fn a_crushing_press_gives_the_same_bits_on_one_and_two_threads() {
 #[test]
 fn what_the_estimate_does_not_hold_is_refused_by_name() {
     // fully integrated elements without F-bar: locking stiffness the operator does not hold
-    let src = free_box([5.0, 4.0, 4.0], [5, 4, 4], "")
-        .replace("material = \"m\"", "material = \"m\"\nformulation = \"full\"");
+    let src = free_box([5.0, 4.0, 4.0], [5, 4, 4], "").replace(
+        "material = \"m\"",
+        "material = \"m\"\nformulation = \"full\"",
+    );
     let mut scene = common::scene_from_str(&src);
     let e = scene.sim.initialise().unwrap_err().to_string();
     assert!(e.contains("full_fbar") && e.contains("`block`"), "{e}");
     // a factor above 0.9: the contact bound assumes the body at most 0.9 of its critical step
-    let src = free_box([5.0, 4.0, 4.0], [5, 4, 4], "")
-        .replace("step_estimate = \"global\"", "step_estimate = \"global\"\ndt_factor = 0.95");
+    let src = free_box([5.0, 4.0, 4.0], [5, 4, 4], "").replace(
+        "step_estimate = \"global\"",
+        "step_estimate = \"global\"\ndt_factor = 0.95",
+    );
     let mut scene = common::scene_from_str(&src);
     let e = scene.sim.initialise().unwrap_err().to_string();
     assert!(e.contains("run.dt_factor"), "{e}");
