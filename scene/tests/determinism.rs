@@ -5,34 +5,7 @@
 mod common;
 use scene::Scene;
 
-const SCENE: &str = r#"
-[run]
-end_time = "2 ms"
-[mesh]
-generator = "box"
-size = ["30 mm", "20 mm", "20 mm"]
-divisions = [30, 12, 10]
-distortion = 0.2
-part = "block"
-[materials.m]
-law = "neo_hookean"
-density = "1000 kg/m^3"
-youngs_modulus = "1 MPa"
-poisson_ratio = 0.45
-[[part]]
-name = "block"
-material = "m"
-formulation = "FORM"
-[[boundary]]
-nodes = "zmin"
-fix = ["all"]
-[[boundary]]
-nodes = "zmax"
-velocity = { z = { kind = "constant", value = "-1 m/s" }, x = { kind = "constant", value = "0.3 m/s" } }
-EXTRA
-[output]
-vtk = false
-"#;
+use common::PRESSED_BLOCK as SCENE;
 
 fn run(threads: usize, form: &str) -> (Vec<[f64; 3]>, f64) {
     run_with(threads, form, "")

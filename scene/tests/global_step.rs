@@ -198,39 +198,19 @@ fn thin_layers_run_on_the_mesh_step_with_the_same_answer() {
 /// `how`, on `threads` threads: (displacements, internal energy, estimates, largest energy
 /// error over the last 4 ms).
 fn crushing_press(threads: usize, how: &str) -> (Vec<[f64; 3]>, f64, u64, f64) {
-    let src = r#"
-[run]
-end_time = "8 ms"
-step_estimate = "HOW"
-[mesh]
-generator = "box"
-size = ["30 mm", "20 mm", "20 mm"]
-divisions = [30, 12, 10]
-distortion = 0.2
-part = "block"
-[materials.m]
-law = "neo_hookean"
-density = "1000 kg/m^3"
-youngs_modulus = "1 MPa"
-poisson_ratio = 0.45
-[[part]]
-name = "block"
-material = "m"
-[[boundary]]
-nodes = "zmin"
-fix = ["all"]
-[[boundary]]
-nodes = "zmax"
-velocity = { z = { kind = "constant", value = "-1 m/s" }, x = { kind = "constant", value = "0.3 m/s" } }
-[output]
-vtk = false
-"#;
+    let src = common::PRESSED_BLOCK
+        .replace(
+            "end_time = \"2 ms\"",
+            &format!("end_time = \"8 ms\"\nstep_estimate = \"{how}\""),
+        )
+        .replace("FORM", "one_point")
+        .replace("EXTRA", "");
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(threads)
         .build()
         .unwrap();
     pool.install(|| {
-        let mut scene: Scene = common::scene_from_str(&src.replace("HOW", how));
+        let mut scene: Scene = common::scene_from_str(&src);
         let mut worst = 0.0f64;
         while scene.sim.time < 8e-3 {
             scene.sim.step(f64::INFINITY).unwrap();

@@ -101,3 +101,35 @@ reactions = ["x0"]
         .last()
         .unwrap()
 }
+
+/// A distorted 30 x 20 x 20 mm block of a nu = 0.45 neo-Hookean solid on a fixed base, its top
+/// pressed at 1 m/s and sheared at 0.3 m/s, ending at 2 ms: `FORM` is the formulation and
+/// `EXTRA` more tables (the determinism and global-step tests).
+pub const PRESSED_BLOCK: &str = r#"
+[run]
+end_time = "2 ms"
+[mesh]
+generator = "box"
+size = ["30 mm", "20 mm", "20 mm"]
+divisions = [30, 12, 10]
+distortion = 0.2
+part = "block"
+[materials.m]
+law = "neo_hookean"
+density = "1000 kg/m^3"
+youngs_modulus = "1 MPa"
+poisson_ratio = 0.45
+[[part]]
+name = "block"
+material = "m"
+formulation = "FORM"
+[[boundary]]
+nodes = "zmin"
+fix = ["all"]
+[[boundary]]
+nodes = "zmax"
+velocity = { z = { kind = "constant", value = "-1 m/s" }, x = { kind = "constant", value = "0.3 m/s" } }
+EXTRA
+[output]
+vtk = false
+"#;
