@@ -58,6 +58,7 @@
 //! `1 - RENEW_FALL` (at most every [`MIN_SPACING`] steps); the loop before an estimate records
 //! every element's step (`Group::record_dt`). The step never goes below the element estimate
 //! `f min_e dt_e`.
+use crate::element::{max_face_area, Nodal};
 use crate::model::Model;
 use rayon::prelude::*;
 
@@ -176,16 +177,7 @@ impl GlobalStep {
     /// `s(t)` of the element loop that has just run: the smallest ratio of an element's step
     /// now to its step at the last estimate, at most 1 (1 before the first estimate).
     pub fn fall(model: &Model) -> f64 {
-        let rise = model
-            .groups
-            .iter()
-            .flat_map(|g| g.chunks.iter().map(|c| c.rise))
-            .fold(0.0, f64::max);
-        if rise > 1.0 {
-            1.0 / rise
-        } else {
-            1.0
-        }
+        largest_rise(model).map_or(1.0, |(rise, _)| 1.0 / rise)
     }
 
     /// Whether the next element loop should record the elements' steps for an estimate at
@@ -215,13 +207,8 @@ impl GlobalStep {
         let mut dts = vec![f64::INFINITY; model.mesh.elements.len()];
         let mut element = f64::INFINITY;
         // the element whose step fell most since the last estimate (its neighbourhood is where
-        // a new fastest mode would be), chunks in order
-        let mut hot: Option<(f64, u32)> = None;
-        for ch in model.groups.iter().flat_map(|g| g.chunks.iter()) {
-            if ch.rise > 1.0 && hot.is_none_or(|(r, _)| ch.rise > r) {
-                hot = Some((ch.rise, ch.rise_elem));
-            }
-        }
+        // a new fastest mode would be)
+        let hot = largest_rise(model);
         for g in model.groups.iter_mut() {
             g.record_dt = false;
             g.dt_reference.clear();
@@ -331,6 +318,18 @@ impl GlobalStep {
     }
 }
 
+/// The largest fall of an element's step since the last estimate in the element loop that has
+/// just run, as the ratio then / now (above 1), and its element; groups and chunks in order.
+fn largest_rise(model: &Model) -> Option<(f64, u32)> {
+    let mut hot: Option<(f64, u32)> = None;
+    for ch in model.groups.iter().flat_map(|g| g.chunks.iter()) {
+        if ch.rise > 1.0 && hot.is_none_or(|(r, _)| ch.rise > r) {
+            hot = Some((ch.rise, ch.rise_elem));
+        }
+    }
+    hot
+}
+
 /// The operator's elements at displacements `u`, with `dts` each element's step from the
 /// element loop of this state (global id; before `kappa`, with its density scale, current wave
 /// speed and bulk viscosity; infinite for an eroded or faulted element, which adds no
@@ -383,11 +382,13 @@ fn operator(model: &Model, u: &[[f64; 3]], dts: &[f64]) -> Vec<OpElement> {
                     return op;
                 }
                 let (bi, q) = (le / material::real::LANES, le % material::real::LANES);
-                let b0: [[f64; 8]; 3] = std::array::from_fn(|i| {
+                let b0: Nodal = std::array::from_fn(|i| {
                     std::array::from_fn(|a| g.grad[bi][i][a].to_array()[q])
                 });
+                // F summed node by node from the identity (`element::deformation_gradient`
+                // sums in another order; its last digits would move the estimate and the run)
                 let mut f = nalgebra::Matrix3::<f64>::identity();
-                let mut x = [[0.0; 8]; 3];
+                let mut x: Nodal = [[0.0; 8]; 3];
                 for a in 0..8 {
                     let n = conn[a] as usize;
                     for i in 0..3 {
@@ -408,7 +409,7 @@ fn operator(model: &Model, u: &[[f64; 3]], dts: &[f64]) -> Vec<OpElement> {
                 }
                 let s = g.density_scale.get(le).copied().unwrap_or(1.0);
                 op.volume = j * g.vol0[le];
-                let initial = op.volume / crate::element::max_face_area(&x) / c0 * s.sqrt();
+                let initial = op.volume / max_face_area(&x) / c0 * s.sqrt();
                 let phi = (initial / dt).powi(2);
                 op.lambda = phi * lambda;
                 op.mu = phi * mu;
