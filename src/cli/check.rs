@@ -36,7 +36,7 @@ pub fn check(path: &Path, deck: &DeckArgs, pilot: Pilot) -> Result<(), String> {
             return Err(e);
         }
     };
-    let scene = loaded.scene;
+    let mut scene = loaded.scene;
     let sim = &scene.sim;
     let m = &sim.model;
     let mesh = &m.mesh;
@@ -159,7 +159,46 @@ pub fn check(path: &Path, deck: &DeckArgs, pilot: Pilot) -> Result<(), String> {
     println!("  stages: {}", sim.active_stages().join(", "));
     let elements = mesh.elements.len();
     print_pilot(path, &scene, pilot, lsdyna::is_deck(path), elements);
+    print_global_step(&mut scene.sim);
     Ok(())
+}
+
+/// The mesh's own critical step at the start ([`solver::global_step`]): what
+/// `run.step_estimate = "global"` starts from, printed whichever estimate the scene asks for.
+/// It costs one element loop and one Lanczos estimate, on the scene's own simulation (the last
+/// thing `check` does with it).
+fn print_global_step(sim: &mut solver::simulation::Simulation) {
+    use solver::simulation::StepEstimate;
+    let asked = sim.settings.step_estimate == StepEstimate::Global;
+    if sim.settings.subcycling > 1 {
+        return println!(
+            "  global step estimate: not available beside subcycling (run.subcycling = {})",
+            sim.settings.subcycling
+        );
+    }
+    sim.settings.step_estimate = StepEstimate::Global;
+    let estimate = sim.initialise().map_err(|e| e.to_string()).and_then(|()| {
+        sim.global_step
+            .as_ref()
+            .map(|g| (g.critical_step(), g.report))
+            .filter(|(g, _)| *g > 0.0)
+            .ok_or_else(|| "the estimate broke down (no stiffness)".to_string())
+    });
+    let f = sim.settings.dt_factor;
+    match estimate {
+        Ok((g, r)) => println!(
+            "  global step estimate: the mesh's critical step {g:.4e} s, {:.2} x the element estimate ({} Lanczos iterations, {:.2} s); {}",
+            r.ratio.1,
+            r.iterations,
+            r.seconds,
+            if asked {
+                format!("the run starts at {:.4e} s (factor {f}, never below the element estimate)", sim.dt_next)
+            } else {
+                "run.step_estimate = \"global\" would use it".to_string()
+            }
+        ),
+        Err(e) => println!("  global step estimate: not available: {e}"),
+    }
 }
 
 /// The mesh's element bandwidth (the largest node-number spread of one element), with a hint

@@ -4,11 +4,14 @@
 //! abdomen phantom ([`scene::palpation`]): the mesh size (voxel edge), the element formulation,
 //! selective mass scaling (targets of 1, 2, 4 and 10 times the initial stable step; 1 is
 //! palpate's default, which adds mass only to elements that shrink during the run), the bulk
-//! modulus cap (K/G 5e3, 1e3, 5e2 against the laws' own 5e4) and the time-step factor. Each setting changes one knob of a base setting (one-point elements with
-//! shear-scaled viscous hourglass control, no mass scaling, time-step factor 0.9, the coarsest
-//! mesh) and is run to the end; the study records its wall time, its element-cycles (elements x
-//! steps) and two errors against the most accurate setting of the same knob (the finest mesh,
-//! the fully integrated F-bar element, no mass scaling, time-step factor 0.5), so that each
+//! modulus cap (K/G 5e3, 1e3, 5e2 against the laws' own 5e4), the time-step factor and the
+//! step estimate (element by element, or the mesh's own critical step of
+//! [`solver::global_step`]). Each setting changes one knob of a base setting (one-point
+//! elements with shear-scaled viscous hourglass control, no mass scaling, time-step factor 0.9,
+//! the element estimate, the coarsest mesh) and is run to the end; the study records its wall
+//! time, its element-cycles (elements x steps) and two errors against the most accurate
+//! setting of the same knob (the finest mesh, the fully integrated F-bar element, no mass
+//! scaling, time-step factor 0.5, the element estimate), so that each
 //! knob's price in accuracy is measured on its own:
 //!
 //! - force: the relative RMS difference of the hand force history (both histories filtered
@@ -34,6 +37,7 @@ use scene::run::{run_scene, RunSummary};
 use solver::model::StepTarget;
 use solver::output::filter::{moving_average, moving_average_at, FORCE_FILTER};
 use solver::output::history::{column, read_history};
+use solver::simulation::StepEstimate;
 use std::collections::HashMap;
 use std::fmt::Write;
 use std::path::{Path, PathBuf};
@@ -160,6 +164,20 @@ fn plan(quick: bool) -> Vec<Variant> {
                 ..base.clone()
             },
             f == 0.5,
+        );
+    }
+    // The step estimate at factor 0.9: the mesh's own critical step (a global Lanczos
+    // estimate) against the element estimate, the shorter step and so the reference (the
+    // contact penalty, designed on the initial step, is the same in both).
+    for est in [StepEstimate::Element, StepEstimate::Global] {
+        push(
+            "step estimate",
+            est.name().into(),
+            PalpationSetup {
+                step_estimate: est,
+                ..base.clone()
+            },
+            est == StepEstimate::Element,
         );
     }
     v

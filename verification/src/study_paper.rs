@@ -15,7 +15,8 @@
 //!   initial step, the cheapest row within the budget of [`crate::study_paper_report`]);
 //! - knobs: mesh (4 and 2.5 mm), element (the viscous one-point form palpate runs by default,
 //!   and F-bar), the K/G cap (the laws' own 5e4, 1e3, 5e2), mass scaling (off, 1.3x and 2x
-//!   the initial step), time-step factor (0.5, 0.75) and precision (`f64`);
+//!   the initial step), time-step factor (0.5, 0.75), precision (`f64`) and the step
+//!   estimate (the mesh's own critical step, [`solver::global_step`]);
 //! - reference: the most faithful setting affordable on 2 cores: fully integrated F-bar
 //!   elements, the laws' own bulk moduli, `f64`, 3 mm, time-step factor 0.9, and mass scaling
 //!   to the initial step (no element gets mass at the start, crushed elements get enough to
@@ -51,6 +52,7 @@ use scene::palpation::{ElementChoice, PalpationSetup, Place};
 use scene::run::RunStatus;
 use solver::element::precision::Precision;
 use solver::model::StepTarget;
+use solver::simulation::StepEstimate;
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
@@ -153,6 +155,11 @@ pub fn plan(location: &str) -> Vec<StudySetting> {
         "f64",
         one(&|s| s.precision = Precision::F64),
     ));
+    v.push(StudySetting::new(
+        "step estimate",
+        "global",
+        one(&|s| s.step_estimate = StepEstimate::Global),
+    ));
     v
 }
 
@@ -253,6 +260,7 @@ mod tests {
                 }
                 "dt factor" => s.dt_factor = base.dt_factor,
                 "precision" => s.precision = base.precision,
+                "step estimate" => s.step_estimate = base.step_estimate,
                 k => panic!("unknown knob {k}"),
             }
             assert_ne!(st.setup, s, "{} = {} changes nothing", st.knob, st.setting);

@@ -1,0 +1,77 @@
+//! `palpa check` prints the mesh's own critical step ([`solver::global_step`]) whichever
+//! estimate the scene asks for: on the free block of 1 mm cubes of
+//! `verification/python/hex_stability_eigen.py` (one-point, nu = 0.49) the dense eigenvalues
+//! give 0.855 h / c; a scene with subcycling, which the global estimate cannot join, is told why.
+
+#[path = "support/cli.rs"]
+mod cli;
+
+/// A free 5 x 4 x 4 mm block of 1 mm cubes of a nu = 0.49 linear elastic solid, `run_extra`
+/// in `[run]`.
+fn free_block(run_extra: &str) -> String {
+    format!(
+        r#"
+[run]
+end_time = "1 ms"
+{run_extra}
+[mesh]
+generator = "box"
+size = ["5 mm", "4 mm", "4 mm"]
+divisions = [5, 4, 4]
+part = "block"
+[materials.m]
+law = "linear_elastic"
+density = "1000 kg/m^3"
+youngs_modulus = "300 kPa"
+poisson_ratio = 0.49
+[[part]]
+name = "block"
+material = "m"
+[output]
+vtk = false
+"#
+    )
+}
+
+/// `palpa check`'s global-step line for `scene`.
+fn global_line(scene: &str) -> String {
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("block.toml");
+    std::fs::write(&path, scene).unwrap();
+    let stdout = cli::ok(&["check", cli::s(&path), "--no-pilot"]);
+    stdout
+        .lines()
+        .find(|l| l.contains("global step estimate"))
+        .unwrap_or_else(|| panic!("no global-step line:\n{stdout}"))
+        .to_string()
+}
+
+/// The number after `key` in `line`.
+fn number_after(line: &str, key: &str) -> f64 {
+    let rest = &line[line.find(key).unwrap_or_else(|| panic!("{key} in {line}")) + key.len()..];
+    rest.split_whitespace().next().unwrap().parse().unwrap()
+}
+
+#[test]
+fn check_prints_the_meshs_critical_step() {
+    let (e, nu, rho): (f64, f64, f64) = (300e3, 0.49, 1000.0);
+    let c = (e * (1.0 - nu) / ((1.0 + nu) * (1.0 - 2.0 * nu)) / rho).sqrt();
+    for (extra, tail) in [
+        ("", "would use it"),
+        ("step_estimate = \"global\"", "the run starts at"),
+    ] {
+        let line = global_line(&free_block(extra));
+        let ratio = number_after(&line, "critical step") / (1e-3 / c);
+        assert!((ratio - 0.855).abs() < 0.0015, "{ratio}: {line}");
+        assert!(line.contains(tail), "{line}");
+    }
+}
+
+#[test]
+fn check_says_why_subcycling_has_no_global_estimate() {
+    let line = global_line(&free_block("subcycling = 2"));
+    assert!(
+        line.contains("not available") && line.contains("subcycling"),
+        "{line}"
+    );
+}
