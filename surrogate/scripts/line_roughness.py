@@ -63,7 +63,7 @@ def smooth_fits(ys, line, step):
     s = np.arange(len(line)) * step
     y = np.stack([ys[l] for l in line])
     flat = y.reshape(len(line), -1)
-    for deg in (1, 2, 3):
+    for deg in range(1, min(3, len(line) - 2) + 1):
         c = np.polynomial.polynomial.polyfit(s, flat, deg)
         p = np.polynomial.polynomial.polyval(s, c).T.reshape(y.shape)
         print(f"  a degree-{deg} polynomial in position over {s[-1] * 1e3:.0f} mm, fitted to "
@@ -75,7 +75,7 @@ def lines(labels):
     xs = sorted((l for l in labels if l.startswith("X")), key=lambda l: int(l[1:]))
     ys = sorted((l for l in labels if l.startswith("Y")), key=lambda l: int(l[1:]))
     centre = xs[len(xs) // 2]
-    ys = ys[: len(ys) // 2] + [centre] + ys[len(ys) // 2 :]
+    ys = ys[: len(ys) // 2] + [centre] + ys[len(ys) // 2 :] if ys else []
     return {"x": xs, "y": ys}
 
 
@@ -91,6 +91,8 @@ def main(d, h):
     print(f"{d}: {len(labels)} locations, {y.shape[0] // len(labels)} samples each"
           + (f", recovered over H = {h * 1e3:g} mm" if h else ", element stress"))
     for axis, line in lines(labels).items():
+        if len(line) < 3:
+            continue
         step = np.linalg.norm(xy[line[1]] - xy[line[0]])
         print(f"\nalong {axis}: {len(line)} points {step * 1e3:.2f} mm apart")
         n = len(line)
