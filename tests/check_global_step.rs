@@ -1,7 +1,8 @@
 //! `palpa check` prints the mesh's own critical step ([`solver::global_step`]) whichever
 //! estimate the scene asks for: on the free block of 1 mm cubes of
 //! `verification/python/hex_stability_eigen.py` (one-point, nu = 0.49) the dense eigenvalues
-//! give 0.855 h / c; a scene with subcycling, which the global estimate cannot join, is told why.
+//! give 0.855 h / c. Beside subcycling or a factor above 0.9, which a run refuses with the global
+//! estimate, the estimate is still printed and the refusal named.
 
 #[path = "support/cli.rs"]
 mod cli;
@@ -58,20 +59,29 @@ fn check_prints_the_meshs_critical_step() {
     let c = (e * (1.0 - nu) / ((1.0 + nu) * (1.0 - 2.0 * nu)) / rho).sqrt();
     for (extra, tail) in [
         ("", "would use it"),
-        ("step_estimate = \"global\"", "the run starts at"),
+        ("step_estimate = \"global\"", "the run uses it"),
+        (
+            "subcycling = 2",
+            "a run refuses it beside run.subcycling = 2",
+        ),
+        (
+            "dt_factor = 0.95",
+            "a run refuses it beside run.dt_factor = 0.95",
+        ),
     ] {
         let line = global_line(&free_block(extra));
         let ratio = number_after(&line, "critical step") / (1e-3 / c);
         assert!((ratio - 0.855).abs() < 0.0015, "{ratio}: {line}");
         assert!(line.contains(tail), "{line}");
+        // the bound at factor 0.9 (0.95 is set aside), and the steps it gives to 1 ms
+        let words: Vec<&str> = line[line.find("at factor 0.9:").unwrap()..]
+            .split_whitespace()
+            .collect();
+        let (bound, steps): (f64, f64) = (words[3].parse().unwrap(), words[5].parse().unwrap());
+        assert!(
+            (bound / (0.9 * ratio * 1e-3 / c) - 1.0).abs() < 1e-3,
+            "{line}"
+        );
+        assert_eq!(steps, (1e-3 / bound).ceil(), "{line}");
     }
-}
-
-#[test]
-fn check_says_why_subcycling_has_no_global_estimate() {
-    let line = global_line(&free_block("subcycling = 2"));
-    assert!(
-        line.contains("not available") && line.contains("subcycling"),
-        "{line}"
-    );
 }

@@ -159,22 +159,43 @@ pub fn check(path: &Path, deck: &DeckArgs, pilot: Pilot) -> Result<(), String> {
     println!("  stages: {}", sim.active_stages().join(", "));
     let elements = mesh.elements.len();
     print_pilot(path, &scene, pilot, lsdyna::is_deck(path), elements);
-    print_global_step(&mut scene.sim);
+    print_global_step(&mut scene.sim, scene.end_time);
     Ok(())
 }
 
+/// Most bytes the Lanczos basis of `check`'s global estimate may take (f32 x 3 per node and
+/// iteration, up to [`LANCZOS_ITERATIONS`]); larger meshes skip it.
+const LANCZOS_BUDGET: f64 = 1024.0 * 1048576.0;
+/// Lanczos iterations counted in [`LANCZOS_BUDGET`] (the first estimate of the 3 mm phantom
+/// takes 28-60).
+const LANCZOS_ITERATIONS: f64 = 60.0;
+
 /// The mesh's own critical step at the start ([`solver::global_step`]): what
-/// `run.step_estimate = "global"` starts from, printed whichever estimate the scene asks for.
-/// It costs one element loop and one Lanczos estimate, on the scene's own simulation (the last
-/// thing `check` does with it).
-fn print_global_step(sim: &mut solver::simulation::Simulation) {
-    use solver::simulation::StepEstimate;
-    let asked = sim.settings.step_estimate == StepEstimate::Global;
-    if sim.settings.subcycling > 1 {
+/// `run.step_estimate = "global"` starts from, printed whichever estimate the scene asks for,
+/// with the steps it gives to `end_time` (s). It costs one element loop and one Lanczos
+/// estimate, on the scene's own simulation (the last thing `check` does with it). Subcycling
+/// and a factor above 0.9, which a run refuses beside the global estimate, are set aside for
+/// the estimate and named.
+fn print_global_step(sim: &mut solver::simulation::Simulation, end_time: f64) {
+    use solver::simulation::{StepEstimate, DEFAULT_DT_FACTOR};
+    let nodes = sim.model.mesh.nodes.len() as f64;
+    let basis = nodes * 12.0 * LANCZOS_ITERATIONS;
+    if basis > LANCZOS_BUDGET {
         return println!(
-            "  global step estimate: not available beside subcycling (run.subcycling = {})",
-            sim.settings.subcycling
+            "  global step estimate: not computed: its Lanczos basis would take up to {:.0} MiB for {nodes} nodes",
+            basis / 1048576.0
         );
+    }
+    let asked = sim.settings.step_estimate == StepEstimate::Global;
+    let f = sim.settings.dt_factor;
+    let mut refused = Vec::new();
+    if sim.settings.subcycling > 1 {
+        refused.push(format!("run.subcycling = {}", sim.settings.subcycling));
+        sim.settings.subcycling = 1;
+    }
+    if f > DEFAULT_DT_FACTOR {
+        refused.push(format!("run.dt_factor = {f}"));
+        sim.settings.dt_factor = DEFAULT_DT_FACTOR;
     }
     sim.settings.step_estimate = StepEstimate::Global;
     let estimate = sim.initialise().map_err(|e| e.to_string()).and_then(|()| {
@@ -184,21 +205,28 @@ fn print_global_step(sim: &mut solver::simulation::Simulation) {
             .filter(|(g, _)| *g > 0.0)
             .ok_or_else(|| "the estimate broke down (no stiffness)".to_string())
     });
+    let (g, r) = match estimate {
+        Ok(e) => e,
+        Err(e) => return println!("  global step estimate: not available: {e}"),
+    };
+    // the element loop's smallest estimate at the same state (mass scaling and the law's
+    // current wave speed included), which the step never goes below
+    let element = g / r.ratio.1;
     let f = sim.settings.dt_factor;
-    match estimate {
-        Ok((g, r)) => println!(
-            "  global step estimate: the mesh's critical step {g:.4e} s, {:.2} x the element estimate ({} Lanczos iterations, {:.2} s); {}",
-            r.ratio.1,
-            r.iterations,
-            r.seconds,
-            if asked {
-                format!("the run starts at {:.4e} s (factor {f}, never below the element estimate)", sim.dt_next)
-            } else {
-                "run.step_estimate = \"global\" would use it".to_string()
-            }
-        ),
-        Err(e) => println!("  global step estimate: not available: {e}"),
-    }
+    let bound = (f * g.max(element)).min(sim.settings.dt_max);
+    println!(
+        "  global step estimate: the mesh's critical step {g:.4e} s, {:.2} x the element loop's {element:.4e} s ({} Lanczos iterations, {:.2} s); at factor {f}: {bound:.4e} s, {:.0} steps for end time {:.4} ms (other stages' bounds, such as contact's, may hold the step lower); {}",
+        r.ratio.1,
+        r.iterations,
+        r.seconds,
+        (end_time / bound).ceil(),
+        end_time * 1e3,
+        match (refused.is_empty(), asked) {
+            (false, _) => format!("a run refuses it beside {}", refused.join(" and ")),
+            (true, true) => "the run uses it".to_string(),
+            (true, false) => "run.step_estimate = \"global\" would use it".to_string(),
+        }
+    );
 }
 
 /// The mesh's element bandwidth (the largest node-number spread of one element), with a hint
