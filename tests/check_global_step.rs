@@ -6,32 +6,13 @@
 
 #[path = "support/cli.rs"]
 mod cli;
+#[path = "../scene/tests/common/mod.rs"]
+mod common;
 
 /// A free 5 x 4 x 4 mm block of 1 mm cubes of a nu = 0.49 linear elastic solid, `run_extra`
 /// in `[run]`.
 fn free_block(run_extra: &str) -> String {
-    format!(
-        r#"
-[run]
-end_time = "1 ms"
-{run_extra}
-[mesh]
-generator = "box"
-size = ["5 mm", "4 mm", "4 mm"]
-divisions = [5, 4, 4]
-part = "block"
-[materials.m]
-law = "linear_elastic"
-density = "1000 kg/m^3"
-youngs_modulus = "300 kPa"
-poisson_ratio = 0.49
-[[part]]
-name = "block"
-material = "m"
-[output]
-vtk = false
-"#
-    )
+    common::free_box(run_extra, [5.0, 4.0, 4.0], [5, 4, 4], "")
 }
 
 /// `palpa check`'s global-step line for `scene`.

@@ -11,33 +11,9 @@ use scene::Scene;
 use solver::hex::element_geometry;
 use solver::output::history::column;
 
-/// A free box of `divisions` elements with `mesh_extra` in `[mesh]`, of a nu = 0.49 linear
-/// elastic solid, and `run_extra` in `[run]`.
+/// The shared free box ([`common::free_box`]) on the global estimate.
 fn free_box(size_mm: [f64; 3], divisions: [usize; 3], mesh_extra: &str) -> String {
-    format!(
-        r#"
-[run]
-end_time = "1 ms"
-step_estimate = "global"
-[mesh]
-generator = "box"
-size = ["{} mm", "{} mm", "{} mm"]
-divisions = [{}, {}, {}]
-part = "block"
-{mesh_extra}
-[materials.m]
-law = "linear_elastic"
-density = "1000 kg/m^3"
-youngs_modulus = "300 kPa"
-poisson_ratio = 0.49
-[[part]]
-name = "block"
-material = "m"
-[output]
-vtk = false
-"#,
-        size_mm[0], size_mm[1], size_mm[2], divisions[0], divisions[1], divisions[2]
-    )
+    common::free_box("step_estimate = \"global\"", size_mm, divisions, mesh_extra)
 }
 
 /// The mesh's critical step by the estimator, after the first force evaluation (s).

@@ -133,3 +133,39 @@ EXTRA
 [output]
 vtk = false
 "#;
+
+/// A free box of `divisions` elements with `mesh_extra` in `[mesh]`, of a nu = 0.49 linear
+/// elastic solid (E = 300 kPa, 1000 kg/m^3), and `run_extra` in `[run]`: the regular block of
+/// `verification/python/hex_stability_eigen.py` with 1 mm cubes. Shared with the command-line
+/// tests (`tests/check_global_step.rs`).
+pub fn free_box(
+    run_extra: &str,
+    size_mm: [f64; 3],
+    divisions: [usize; 3],
+    mesh_extra: &str,
+) -> String {
+    format!(
+        r#"
+[run]
+end_time = "1 ms"
+{run_extra}
+[mesh]
+generator = "box"
+size = ["{} mm", "{} mm", "{} mm"]
+divisions = [{}, {}, {}]
+part = "block"
+{mesh_extra}
+[materials.m]
+law = "linear_elastic"
+density = "1000 kg/m^3"
+youngs_modulus = "300 kPa"
+poisson_ratio = 0.49
+[[part]]
+name = "block"
+material = "m"
+[output]
+vtk = false
+"#,
+        size_mm[0], size_mm[1], size_mm[2], divisions[0], divisions[1], divisions[2]
+    )
+}
