@@ -109,8 +109,8 @@ enum Command {
         out: PathBuf,
     },
     /// Accuracy against cost: vary mesh size, element formulation, mass scaling, the bulk
-    /// modulus cap and the time-step factor on the phantom palpation; write study.csv, study.md
-    /// and Pareto plots into --out.
+    /// modulus cap, the time-step factor and the step estimate on the phantom palpation; write
+    /// study.csv, study.md and Pareto plots into --out.
     Study {
         /// The quick profile (coarse phantom, 6 mm in 6 ms): a few minutes on 2 cores.
         #[arg(long, conflicts_with = "paper")]

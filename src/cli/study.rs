@@ -1,5 +1,6 @@
 //! `palpa study [--quick] [--out DIR]`: accuracy against cost of every speed knob (mesh size,
-//! element formulation, mass scaling, time-step factor) on the phantom palpation; see
+//! element formulation, mass scaling, bulk-modulus cap, time-step factor, step estimate) on the
+//! phantom palpation; see
 //! [`verification::study`]. Writes `study.csv`, `study.md` and the Pareto plots.
 //!
 //! `palpa study --paper [--locations A,B,C] [--report-only | --dry-run] [--out DIR]`: the same
