@@ -80,6 +80,8 @@ pub const DEFAULT_INTERVAL: u64 = 500;
 /// renewals (`s` lowers the step at once); a renewal only gives back a step that a crushed but
 /// well-surrounded element took away.
 pub const MIN_SPACING: u64 = 100;
+/// Bytes per node and Lanczos iteration of the kept basis (`f32` x 3).
+pub const BASIS_BYTES_PER_NODE: usize = 3 * std::mem::size_of::<f32>();
 /// Elements or nodes per parallel work item (a fixed size, so the sums do not depend on the
 /// threads).
 const CHUNK: usize = 1024;
@@ -200,7 +202,7 @@ impl GlobalStep {
         self.global * s.min(1.0)
     }
 
-    /// Estimate at displacements `u` and masses `mass`, from the element loop that has just
+    /// Estimate at displacements `u` and the model's masses, from the element loop that has just
     /// run with every group's `record_dt` set: its steps become the groups' `dt_reference`.
     pub fn estimate(&mut self, model: &mut Model, u: &[[f64; 3]], step: u64) {
         let t0 = std::time::Instant::now();
@@ -277,6 +279,7 @@ impl GlobalStep {
         }
         let nq = dot(&q, &q).sqrt();
         scale(&mut q, 1.0 / nq);
+        // BASIS_BYTES_PER_NODE per node and iteration
         let mut basis: Vec<Vec<[f32; 3]>> = Vec::new();
         let mut prev = vec![[0.0; 3]; n];
         let (mut alpha, mut beta) = (Vec::new(), Vec::<f64>::new());

@@ -163,8 +163,9 @@ pub fn check(path: &Path, deck: &DeckArgs, pilot: Pilot) -> Result<(), String> {
     Ok(())
 }
 
-/// Most bytes the Lanczos basis of `check`'s global estimate may take (f32 x 3 per node and
-/// iteration, up to [`LANCZOS_ITERATIONS`]); larger meshes skip it.
+/// Most bytes the Lanczos basis of `check`'s global estimate may take
+/// ([`solver::global_step::BASIS_BYTES_PER_NODE`] per node and iteration, counted at
+/// [`LANCZOS_ITERATIONS`]); larger meshes skip it.
 const LANCZOS_BUDGET: f64 = 1024.0 * 1048576.0;
 /// Lanczos iterations counted in [`LANCZOS_BUDGET`] (the first estimate of the 3 mm phantom
 /// takes 28-60).
@@ -179,7 +180,7 @@ const LANCZOS_ITERATIONS: f64 = 60.0;
 fn print_global_step(sim: &mut solver::simulation::Simulation, end_time: f64) {
     use solver::simulation::{StepEstimate, DEFAULT_DT_FACTOR};
     let nodes = sim.model.mesh.nodes.len() as f64;
-    let basis = nodes * 12.0 * LANCZOS_ITERATIONS;
+    let basis = nodes * solver::global_step::BASIS_BYTES_PER_NODE as f64 * LANCZOS_ITERATIONS;
     if basis > LANCZOS_BUDGET {
         return println!(
             "  global step estimate: not computed: its Lanczos basis would take up to {:.0} MiB for {nodes} nodes",
