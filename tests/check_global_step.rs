@@ -66,3 +66,34 @@ fn check_prints_the_meshs_critical_step() {
         assert_eq!(steps, (1e-3 / bound).ceil(), "{line}");
     }
 }
+
+/// A scene that asks for the global estimate where a run refuses it fails `check` as the run
+/// would, naming the setting.
+#[test]
+fn check_refuses_what_a_run_refuses() {
+    let dir = tempfile::tempdir().unwrap();
+    for (extra, named) in [
+        (
+            "step_estimate = \"global\"\ndt_factor = 0.95",
+            "run.dt_factor = 0.95",
+        ),
+        (
+            "step_estimate = \"global\"",
+            "fully integrated elements without F-bar",
+        ),
+    ] {
+        let mut src = free_block(extra);
+        if named.contains("F-bar") {
+            src = src.replace(
+                "material = \"m\"",
+                "material = \"m\"\nformulation = \"full\"",
+            );
+        }
+        let path = dir.path().join("block.toml");
+        std::fs::write(&path, src).unwrap();
+        let out = cli::palpa(&["check", cli::s(&path), "--no-pilot"]);
+        let err = String::from_utf8_lossy(&out.stderr);
+        assert_eq!(out.status.code(), Some(1), "{err}");
+        assert!(err.contains(named) && err.contains("block.toml"), "{err}");
+    }
+}

@@ -159,8 +159,8 @@ pub fn check(path: &Path, deck: &DeckArgs, pilot: Pilot) -> Result<(), String> {
     println!("  stages: {}", sim.active_stages().join(", "));
     let elements = mesh.elements.len();
     print_pilot(path, &scene, pilot, lsdyna::is_deck(path), elements);
-    print_global_step(&mut scene.sim, scene.end_time);
-    Ok(())
+    print_global_step(&mut scene.sim, scene.end_time)
+        .map_err(|e| format!("{}: {e}", path.display()))
 }
 
 /// Most bytes the Lanczos basis of `check`'s global estimate may take
@@ -176,16 +176,21 @@ const LANCZOS_ITERATIONS: f64 = 60.0;
 /// with the steps it gives to `end_time` (s). It costs one element loop and one Lanczos
 /// estimate, on the scene's own simulation (the last thing `check` does with it). Subcycling
 /// and a factor above 0.9, which a run refuses beside the global estimate, are set aside for
-/// the estimate and named.
-fn print_global_step(sim: &mut solver::simulation::Simulation, end_time: f64) {
+/// the estimate and named. A scene that asks for the global estimate where a run refuses it
+/// is an error, as the run would be.
+fn print_global_step(
+    sim: &mut solver::simulation::Simulation,
+    end_time: f64,
+) -> Result<(), String> {
     use solver::simulation::{StepEstimate, DEFAULT_DT_FACTOR};
     let nodes = sim.model.mesh.nodes.len() as f64;
     let basis = nodes * solver::global_step::BASIS_BYTES_PER_NODE as f64 * LANCZOS_ITERATIONS;
     if basis > LANCZOS_BUDGET {
-        return println!(
+        println!(
             "  global step estimate: not computed: its Lanczos basis would take up to {:.0} MiB for {nodes} nodes",
             basis / 1048576.0
         );
+        return Ok(());
     }
     let asked = sim.settings.step_estimate == StepEstimate::Global;
     let f = sim.settings.dt_factor;
@@ -208,7 +213,11 @@ fn print_global_step(sim: &mut solver::simulation::Simulation, end_time: f64) {
     });
     let (g, r) = match estimate {
         Ok(e) => e,
-        Err(e) => return println!("  global step estimate: not available: {e}"),
+        Err(e) if asked => return Err(e),
+        Err(e) => {
+            println!("  global step estimate: not available: {e}");
+            return Ok(());
+        }
     };
     // the element loop's smallest estimate at the same state (mass scaling and the law's
     // current wave speed included), which the step never goes below
@@ -228,6 +237,13 @@ fn print_global_step(sim: &mut solver::simulation::Simulation, end_time: f64) {
             (true, false) => "run.step_estimate = \"global\" would use it".to_string(),
         }
     );
+    if asked && !refused.is_empty() {
+        return Err(format!(
+            "run.step_estimate = \"global\" is refused beside {}: a run would stop at its start",
+            refused.join(" and ")
+        ));
+    }
+    Ok(())
 }
 
 /// The mesh's element bandwidth (the largest node-number spread of one element), with a hint
