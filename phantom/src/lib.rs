@@ -51,6 +51,7 @@ mod locations;
 mod params;
 pub mod plan;
 mod roi;
+mod skin_fit;
 pub mod voxel;
 
 pub use anatomy::{Anatomy, BACKGROUND, FLESH, LIVER, RIBS, SPINE, TUMOUR, VISCERA};
@@ -59,10 +60,11 @@ pub use locations::{
     TEST_SEARCH_VOXEL,
 };
 pub use params::{
-    GridParams, PhantomParams, RoiParams, Tumour, Variant, DEFAULT_VOXEL, PAPER_VOXEL,
+    GridParams, PhantomParams, RoiParams, Skin, Tumour, Variant, DEFAULT_VOXEL, PAPER_VOXEL,
 };
 pub use plan::{plan_view, PlanView, PLAN_STEP};
 pub use roi::{carry_roi, organ_parts, select_roi, surface_elements, Roi};
+pub use skin_fit::{SkinFit, MAX_SLOPE_DEG};
 
 use rayon::prelude::*;
 
@@ -74,7 +76,9 @@ use solver::mesh::Mesh;
 pub struct Phantom {
     /// The parameters it was built from.
     pub params: PhantomParams,
-    /// The label volume that was meshed (cropped for the reduced variant), before clean-up.
+    /// The body's label volume (cropped for the reduced variant), before clean-up: the one
+    /// that was meshed, or for a fitted skin the same grid unstretched (the mesh came from its
+    /// stretched twin, [`full_volume`]). Locations read their columns from it.
     pub volume: LabelVolume,
     /// Label -> part map used for meshing.
     pub label_map: LabelMap,
@@ -91,6 +95,8 @@ pub struct Phantom {
     pub locations: Locations,
     /// (tumour part name, stiffness factor relative to liver).
     pub tumours: Vec<(String, f64)>,
+    /// The column stretch of a fitted skin (`skin = "fitted"`), `None` for voxel steps.
+    pub skin_fit: Option<SkinFit>,
 }
 
 /// The phantom's part names, labels 1..5 (tumours come after, see [`tumour_part_name`]).
@@ -145,8 +151,10 @@ fn crop_box(p: &PhantomParams, an: &Anatomy, full: &LabelVolume) -> ([usize; 3],
     }
 }
 
-/// The full-torso label volume and the anatomy it came from.
-pub fn full_volume(p: &PhantomParams) -> Result<(LabelVolume, Anatomy), String> {
+/// The full-torso label volume, the anatomy it came from and, for a fitted skin, the column
+/// stretch its grid was labelled through (a grid point (x, y, zeta) holds the label of body
+/// point (x, y, [`SkinFit::body_z`])).
+pub fn full_volume(p: &PhantomParams) -> Result<(LabelVolume, Anatomy, Option<SkinFit>), String> {
     p.validate()?;
     let an = Anatomy::new(p);
     let h = p.voxel;
@@ -161,6 +169,14 @@ pub fn full_volume(p: &PhantomParams) -> Result<(LabelVolume, Anatomy), String> 
         [h; 3],
         [-(nxh as f64) * h + h / 2.0, h / 2.0, h / 2.0],
     );
+    let fit = match p.skin {
+        Skin::Voxel => None,
+        Skin::Fitted => {
+            let (lo, _) = crop_box(p, &an, &vol);
+            let z0 = vol.index_to_world([0.0, 0.0, lo[2] as f64 - 0.5])[2];
+            Some(SkinFit::new(&an, z0, h)?)
+        }
+    };
     let [nx, ny, _] = dims;
     let slabs: Vec<Vec<u8>> = (0..dims[2])
         .into_par_iter()
@@ -169,19 +185,21 @@ pub fn full_volume(p: &PhantomParams) -> Result<(LabelVolume, Anatomy), String> 
             for j in 0..ny {
                 for i in 0..nx {
                     let c = vol.voxel_center(i, j, k);
-                    s[i + nx * j] = an.label(c[0], c[1], c[2]);
+                    let z = fit.map_or(c[2], |f| f.body_z(&an, c[0], c[2]));
+                    s[i + nx * j] = an.label(c[0], c[1], z);
                 }
             }
             s
         })
         .collect();
     vol.labels = slabs.concat();
-    Ok((vol, an))
+    Ok((vol, an, fit))
 }
 
-/// The label volume of the chosen variant (cropped for the reduced model), unmeshed.
+/// The label volume of the chosen variant (cropped for the reduced model), unmeshed; with a
+/// fitted skin, on the stretched grid ([`full_volume`]).
 pub fn label_volume(p: &PhantomParams) -> Result<LabelVolume, String> {
-    let (full, an) = full_volume(p)?;
+    let (full, an, _) = full_volume(p)?;
     let (lo, hi) = crop_box(p, &an, &full);
     Ok(full.crop(lo, hi))
 }
@@ -203,12 +221,17 @@ fn face_normal(mesh: &Mesh, n: &[u32; 4]) -> [f64; 3] {
 
 /// Build the phantom.
 pub fn build(p: &PhantomParams) -> Result<Phantom, String> {
-    let (full, an) = full_volume(p)?;
+    let (full, an, fit) = full_volume(p)?;
     let (lo, hi) = crop_box(p, &an, &full);
     let volume = full.crop(lo, hi);
     drop(full);
     let map = label_map(p);
     let (mut mesh, mut quality) = mesh_volume(&volume, &map, &p.mesh)?;
+    if let Some(f) = &fit {
+        mesh.nodes
+            .par_iter_mut()
+            .for_each(|x| x[2] = f.body_z(&an, x[0], x[2]));
+    }
 
     // boundary node sets on the bounding planes of the meshed volume
     let plo = volume.index_to_world([-0.5, -0.5, -0.5]);
@@ -263,9 +286,20 @@ pub fn build(p: &PhantomParams) -> Result<Phantom, String> {
     let roi = select_roi(&mesh, &organ, center, &p.roi);
     mesh.element_sets.insert("roi".into(), roi.element_set());
 
+    // the locations' columns (liver depth, ribs above) and the test-location search read
+    // labels by height: on the body's own grid, not a fitted skin's stretched one
+    let plain = match p.skin {
+        Skin::Voxel => None,
+        Skin::Fitted => Some(label_volume(&PhantomParams {
+            skin: Skin::Voxel,
+            ..p.clone()
+        })?),
+    };
+    let columns = plain.as_ref().unwrap_or(&volume);
     let search = if (p.voxel - TEST_SEARCH_VOXEL).abs() > 1e-12 {
         Some(label_volume(&PhantomParams {
             voxel: TEST_SEARCH_VOXEL,
+            skin: Skin::Voxel,
             ..p.clone()
         })?)
     } else {
@@ -274,10 +308,11 @@ pub fn build(p: &PhantomParams) -> Result<Phantom, String> {
     let locations = find_locations(
         &mesh,
         &skin_faces,
-        &volume,
-        search.as_ref().unwrap_or(&volume),
+        columns,
+        search.as_ref().unwrap_or(columns),
         &p.grid,
     )?;
+    let volume = plain.unwrap_or(volume);
     quality = {
         let mut q = MeshQuality::measure(&mesh);
         q.cleanup = quality.cleanup;
@@ -302,6 +337,7 @@ pub fn build(p: &PhantomParams) -> Result<Phantom, String> {
         roi,
         locations,
         tumours,
+        skin_fit: fit,
     })
 }
 
@@ -366,11 +402,24 @@ impl Phantom {
                 }
             )
         };
+        let skin = match &self.skin_fit {
+            None => "skin: voxel steps, smoothed".to_string(),
+            Some(f) => {
+                let (lo, hi) = f.ratio_range();
+                format!(
+                    "skin: fitted to the outline for |x| <= {:.1} mm (steeper flanks keep their voxel steps); columns stretched {:.3}..{:.3}",
+                    f.half_width * 1e3,
+                    lo,
+                    hi
+                )
+            }
+        };
         format!(
-            "phantom {:?}, voxel {:.2} mm, phase {:.2}\n{}\nROI: {} liver surface elements\n{}\n{}\n{}",
+            "phantom {:?}, voxel {:.2} mm, phase {:.2}\n{}\n{}\nROI: {} liver surface elements\n{}\n{}\n{}",
             self.params.variant,
             self.params.voxel * 1e3,
             self.params.respiratory_phase,
+            skin,
             self.quality.summary(),
             self.roi.elements.len(),
             loc(&l.a),

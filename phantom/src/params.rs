@@ -32,6 +32,38 @@ impl std::str::FromStr for Variant {
     }
 }
 
+/// How the anterior skin is meshed.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum Skin {
+    /// Voxel steps, Taubin-smoothed (the paper's image-based mesh).
+    #[default]
+    Voxel,
+    /// One node layer on the analytic outline, the grid's columns stretched to meet it
+    /// (`skin_fit.rs`).
+    Fitted,
+}
+
+impl std::str::FromStr for Skin {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s {
+            "voxel" => Ok(Skin::Voxel),
+            "fitted" => Ok(Skin::Fitted),
+            _ => Err(format!("unknown skin `{s}` (voxel | fitted)")),
+        }
+    }
+}
+
+impl Skin {
+    /// The name a scene gives it.
+    pub fn name(self) -> &'static str {
+        match self {
+            Skin::Voxel => "voxel",
+            Skin::Fitted => "fitted",
+        }
+    }
+}
+
 /// A spherical liver tumour; it becomes its own part ("tumour", "tumour2", ...). In JSON (a
 /// campaign's plan, a dataset's manifest) its lengths carry the unit in the key: `center_m`,
 /// `radius_m`.
@@ -141,6 +173,8 @@ pub struct PhantomParams {
     pub torso_length: f64,
     /// Optional liver tumours.
     pub tumours: Vec<Tumour>,
+    /// Voxel steps or a fitted skin.
+    pub skin: Skin,
     /// Meshing and smoothing options.
     pub mesh: MeshOptions,
     /// Region of interest.
@@ -161,6 +195,7 @@ impl Default for PhantomParams {
             torso_depth: 0.22,
             torso_length: 0.30,
             tumours: Vec::new(),
+            skin: Skin::Voxel,
             mesh: MeshOptions::default(),
             roi: RoiParams::default(),
             grid: GridParams::default(),
