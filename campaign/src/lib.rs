@@ -28,6 +28,7 @@
 //! voxel = "3 mm"                   # the campaign default (a single palpation's is 5 mm)
 //! fat_thickness = "25 mm"          # the campaign default (a single palpation's is 15 mm)
 //! respiratory_phase = 0.0
+//! skin = "voxel"                   # or "fitted": the skin one node layer on the outline
 //! tumours = [{ center = ["-60 mm", "180 mm", "150 mm"], radius = "10 mm", stiffness = 5.0 }]
 //!
 //! [locations]
@@ -160,6 +161,29 @@ mod tests {
         bad["torso_m"] = serde_json::json!([0.3, 0.2]);
         let e = PhantomRecord::from_value(&bad).unwrap_err();
         assert!(e.contains("torso_m"), "{e}");
+        // a voxel skin is not written (plans from before the fitted skin read the same), a
+        // fitted one is, and comes back
+        assert!(!text.contains("skin"), "{text}");
+        p.skin = phantom::Skin::Fitted;
+        let text = serde_json::to_string(&PhantomRecord::of(&p)).unwrap();
+        assert!(text.contains("\"skin\":\"fitted\""), "{text}");
+        let record = PhantomRecord::from_value(&serde_json::from_str(&text).unwrap()).unwrap();
+        assert_eq!(record.to_params(None).unwrap(), p);
+    }
+
+    /// `[phantom] skin` reaches every run's scene, and a misspelt one is named.
+    #[test]
+    fn the_fitted_skin_reaches_the_runs_scenes() {
+        let spec: CampaignSpec = toml::from_str("[phantom]\nskin = \"fitted\"\n").unwrap();
+        let c = spec.resolve().unwrap();
+        assert_eq!(c.base.skin, phantom::Skin::Fitted);
+        let scene = c.setup(&c.runs[0]).scene_toml();
+        assert!(scene.contains("skin = \"fitted\""), "{scene}");
+        assert_eq!(c.phantom_params().unwrap().skin, phantom::Skin::Fitted);
+        assert!(!Campaign::paper().base.scene_toml().contains("skin = "));
+        let spec: CampaignSpec = toml::from_str("[phantom]\nskin = \"fited\"\n").unwrap();
+        let e = spec.resolve().unwrap_err();
+        assert!(e.contains("phantom.skin") && e.contains("fited"), "{e}");
     }
 
     #[test]

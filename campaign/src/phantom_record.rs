@@ -20,6 +20,9 @@ pub struct PhantomRecord {
     pub max_liver_shift_m: f64,
     /// Torso width, depth and length (m).
     pub torso_m: [f64; 3],
+    /// `voxel` or `fitted` (`voxel` when absent: plans written before the fitted skin).
+    #[serde(default = "voxel", skip_serializing_if = "is_voxel")]
+    pub skin: String,
     /// Voxels merged per element edge (1 when absent).
     #[serde(default = "one")]
     pub coarsen: usize,
@@ -36,6 +39,14 @@ pub struct PhantomRecord {
 
 fn one() -> usize {
     1
+}
+
+fn voxel() -> String {
+    "voxel".into()
+}
+
+fn is_voxel(s: &str) -> bool {
+    s == "voxel"
 }
 
 /// The raster of a [`PhantomRecord`].
@@ -69,6 +80,7 @@ impl PhantomRecord {
             respiratory_phase: p.respiratory_phase,
             max_liver_shift_m: p.max_liver_shift,
             torso_m: [p.torso_width, p.torso_depth, p.torso_length],
+            skin: p.skin.name().into(),
             coarsen: p.mesh.coarsen,
             tumours: p.tumours.clone(),
             roi_radius_m: p.roi.radius,
@@ -100,6 +112,7 @@ impl PhantomRecord {
             ..Default::default()
         };
         [p.torso_width, p.torso_depth, p.torso_length] = self.torso_m;
+        p.skin = self.skin.parse()?;
         p.mesh.coarsen = self.coarsen;
         p.tumours = self.tumours.clone();
         p.roi.radius = self.roi_radius_m;

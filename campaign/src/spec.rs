@@ -357,6 +357,11 @@ impl CampaignSpec {
         if let Some(v) = p.respiratory_phase {
             base.respiratory_phase = v.0;
         }
+        if let Some(s) = &p.skin {
+            base.skin = s
+                .parse::<phantom::Skin>()
+                .map_err(|e| format!("phantom.skin: {e}"))?;
+        }
         base.tumours = p
             .tumours
             .iter()

@@ -204,6 +204,8 @@ pub struct PalpationSetup {
     pub fat_thickness: f64,
     /// Respiratory phase 0..1.
     pub respiratory_phase: f64,
+    /// Voxel steps or a fitted skin.
+    pub skin: phantom::Skin,
     /// Tumours.
     pub tumours: Vec<Tumour>,
     /// Where the fingers press.
@@ -257,6 +259,7 @@ impl Default for PalpationSetup {
             voxel: DEFAULT_VOXEL,
             fat_thickness: 0.015,
             respiratory_phase: 0.0,
+            skin: phantom::Skin::Voxel,
             tumours: Vec::new(),
             place: Place::Named("A".into()),
             depth: 0.015,

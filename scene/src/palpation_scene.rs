@@ -153,6 +153,7 @@ impl PalpationSetup {
             voxel: Some(Length(self.voxel)),
             fat_thickness: Some(Length(self.fat_thickness)),
             respiratory_phase: Some(Number(self.respiratory_phase)),
+            skin: (self.skin != phantom::Skin::Voxel).then(|| self.skin.name().to_string()),
             tumours: self
                 .tumours
                 .iter()
@@ -321,6 +322,9 @@ impl PalpationSetup {
             self.fat_thickness,
             toml_num(self.respiratory_phase)
         );
+        if self.skin != phantom::Skin::Voxel {
+            let _ = writeln!(s, "skin = {}", toml_str(self.skin.name()));
+        }
         if !self.tumours.is_empty() {
             s.push_str("tumours = [\n");
             for t in &self.tumours {

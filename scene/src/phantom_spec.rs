@@ -9,6 +9,7 @@
 //! voxel = "5 mm"               # "3 mm" is close to the paper's CT resolution
 //! fat_thickness = "15 mm"
 //! respiratory_phase = 0.0      # 0 exhalation .. 1 inspiration (liver moves up to 20 mm)
+//! skin = "voxel"               # or "fitted": one node layer on the outline, no voxel steps
 //! coarsen = 1                  # merge coarsen^3 voxels before meshing
 //! roi_radius = "60 mm"         # region of interest: liver-surface elements near the edge
 //! roi_count = 377              # at most this many (the paper's 377)
@@ -29,7 +30,7 @@
 use material::quantity::{Length, Number};
 use serde::Deserialize;
 
-use phantom::{PhantomParams, Tumour, Variant};
+use phantom::{PhantomParams, Skin, Tumour, Variant};
 
 /// `[mesh.phantom]`.
 #[derive(Debug, Deserialize, Default, Clone)]
@@ -43,6 +44,9 @@ pub struct PhantomScene {
     pub fat_thickness: Option<Length>,
     /// Respiratory phase 0..1 (default 0).
     pub respiratory_phase: Option<Number>,
+    /// `voxel` (default: smoothed voxel steps) or `fitted` (the grid's columns stretched so
+    /// that the skin is one node layer on the body's outline; `phantom::SkinFit`).
+    pub skin: Option<String>,
     /// Voxel coarsening factor (default 1).
     pub coarsen: Option<usize>,
     /// ROI radius (default 60 mm).
@@ -81,6 +85,9 @@ impl PhantomScene {
         }
         if let Some(v) = self.respiratory_phase {
             p.respiratory_phase = v.0;
+        }
+        if let Some(s) = &self.skin {
+            p.skin = s.parse::<Skin>()?;
         }
         if let Some(c) = self.coarsen {
             if c == 0 {

@@ -117,6 +117,10 @@ pub struct PhantomArgs {
     /// [default: 0].
     #[arg(long, value_name = "0..1")]
     phase: Option<f64>,
+    /// The anterior skin: `voxel` (smoothed voxel steps) or `fitted` (one node layer on the
+    /// body's outline, the grid's columns stretched to meet it).
+    #[arg(long, default_value = "voxel", value_parser = ["voxel", "fitted"])]
+    skin: String,
     /// Caudal liver displacement at phase 1 [default: 20mm].
     #[arg(long, value_name = "LENGTH", value_parser = length)]
     max_shift: Option<f64>,
@@ -432,6 +436,7 @@ fn mesh_phantom(a: PhantomArgs) -> Result<(), String> {
     if let Some(v) = a.phase {
         p.respiratory_phase = v;
     }
+    p.skin = a.skin.parse()?;
     if let Some(v) = a.max_shift {
         p.max_liver_shift = v;
     }

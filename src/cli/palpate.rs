@@ -55,6 +55,10 @@ pub struct PalpateArgs {
     /// Respiratory phase, 0 (exhalation) .. 1 (inspiration).
     #[arg(long, default_value_t = 0.0)]
     pub phase: f64,
+    /// The skin: `voxel` (smoothed voxel steps, the paper's image-based mesh) or `fitted`
+    /// (one node layer on the body's outline, the grid's columns stretched to meet it).
+    #[arg(long, default_value = "voxel")]
+    pub skin: String,
     /// Element formulation [default: one_point]: one_point (= 1pt-viscous-shear: one-point, viscous hourglass
     /// control scaled by the shear modulus), 1pt-viscous or 1pt-stiffness (hourglass scaled by
     /// the P-wave modulus, LS-DYNA types 1 and 4), 1pt-stiffness-shear, 1pt-physical
@@ -141,6 +145,10 @@ impl PalpateArgs {
         s.variant = self.variant.clone();
         s.fat_thickness = units::length(&self.fat, "--fat")?;
         s.respiratory_phase = self.phase;
+        s.skin = self
+            .skin
+            .parse::<phantom::Skin>()
+            .map_err(|e| format!("--skin: {e}"))?;
         s.element = self
             .element
             .as_deref()
