@@ -112,7 +112,10 @@ impl PhantomRecord {
             ..Default::default()
         };
         [p.torso_width, p.torso_depth, p.torso_length] = self.torso_m;
-        p.skin = self.skin.parse()?;
+        p.skin = self
+            .skin
+            .parse()
+            .map_err(|e| format!("phantom parameters: `skin`: {e}"))?;
         p.mesh.coarsen = self.coarsen;
         p.tumours = self.tumours.clone();
         p.roi.radius = self.roi_radius_m;

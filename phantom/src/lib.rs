@@ -196,10 +196,15 @@ pub fn full_volume(p: &PhantomParams) -> Result<(LabelVolume, Anatomy, Option<Sk
     Ok((vol, an, fit))
 }
 
-/// The label volume of the chosen variant (cropped for the reduced model), unmeshed; with a
-/// fitted skin, on the stretched grid ([`full_volume`]).
+/// The body's label volume of the chosen variant (cropped for the reduced model), unmeshed,
+/// on the plain voxel grid whatever the skin (a fitted skin's stretched grid is
+/// [`full_volume`]'s).
 pub fn label_volume(p: &PhantomParams) -> Result<LabelVolume, String> {
-    let (full, an, _) = full_volume(p)?;
+    let plain = PhantomParams {
+        skin: Skin::Voxel,
+        ..p.clone()
+    };
+    let (full, an, _) = full_volume(&plain)?;
     let (lo, hi) = crop_box(p, &an, &full);
     Ok(full.crop(lo, hi))
 }
@@ -228,9 +233,7 @@ pub fn build(p: &PhantomParams) -> Result<Phantom, String> {
     let map = label_map(p);
     let (mut mesh, mut quality) = mesh_volume(&volume, &map, &p.mesh)?;
     if let Some(f) = &fit {
-        mesh.nodes
-            .par_iter_mut()
-            .for_each(|x| x[2] = f.body_z(&an, x[0], x[2]));
+        f.map_mesh(&an, &mut mesh)?;
     }
 
     // boundary node sets on the bounding planes of the meshed volume
@@ -290,16 +293,12 @@ pub fn build(p: &PhantomParams) -> Result<Phantom, String> {
     // labels by height: on the body's own grid, not a fitted skin's stretched one
     let plain = match p.skin {
         Skin::Voxel => None,
-        Skin::Fitted => Some(label_volume(&PhantomParams {
-            skin: Skin::Voxel,
-            ..p.clone()
-        })?),
+        Skin::Fitted => Some(label_volume(p)?),
     };
     let columns = plain.as_ref().unwrap_or(&volume);
     let search = if (p.voxel - TEST_SEARCH_VOXEL).abs() > 1e-12 {
         Some(label_volume(&PhantomParams {
             voxel: TEST_SEARCH_VOXEL,
-            skin: Skin::Voxel,
             ..p.clone()
         })?)
     } else {

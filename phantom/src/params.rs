@@ -211,6 +211,12 @@ impl PhantomParams {
 
     /// Check ranges.
     pub fn validate(&self) -> Result<(), String> {
+        if self.skin == Skin::Fitted && self.mesh.coarsen > 1 {
+            return Err(format!(
+                "skin = \"fitted\" meshes whole voxels: it cannot take coarsen = {} (give a larger voxel instead)",
+                self.mesh.coarsen
+            ));
+        }
         if !(0.0005..=0.05).contains(&self.voxel) {
             return Err(format!(
                 "`voxel` = {} m is out of range (0.5 mm .. 50 mm)",
