@@ -32,6 +32,9 @@
 //!   plane) whose outward normal has z > 0.05 (every upward-facing face, so that a steep,
 //!   smoothed voxel step on a coarse mesh leaves no hole under a palpation location); the faces themselves are in
 //!   [`Phantom::skin_faces`] (outward normal by the right-hand rule), for finger contact.
+//! - The skin is smoothed voxel steps ([`Skin::Voxel`], the default) or one node layer on the
+//!   analytic outline where it is under 30 degrees steep ([`Skin::Fitted`]: the grid's
+//!   columns stretched to meet it, `skin_fit.rs`).
 //!
 //! # Counts
 //! Measured with the defaults (torso 300 x 220 x 300 mm, fat 15 mm, phase 0), release build:

@@ -4,9 +4,9 @@
 //! On a voxel mesh the anterior skin is a staircase: where it slopes by theta the surface rises
 //! one voxel h every h / tan(theta) (18 mm at 3 mm and 9.4 degrees), and Taubin smoothing
 //! (`voxel/smooth.rs`), a low-pass filter with element-quality limits, leaves most of it: facets
-//! 2 degrees and 60 degrees steep, nodes up to 1.3 mm off the outline. A finger sliding along such a slope
-//! meets the riser faces one after another, and the liver's stress follows them (the line
-//! study of `docs/surrogate.md`). A step is a change in the number of voxels in a column, so it
+//! 2 degrees and 60 degrees steep, nodes up to 1.3 mm off the outline. A finger sliding along
+//! such a slope meets the riser faces one after another, and the liver's stress follows them
+//! (the line study of `docs/surrogate.md`). A step is a change in the number of voxels in a column, so it
 //! cannot be smoothed away without collapsing the element at its corner.
 //!
 //! With `skin = "fitted"` the phantom is labelled and meshed in a grid whose columns are
