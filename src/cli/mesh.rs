@@ -26,7 +26,8 @@ pub enum MeshCommand {
     /// part); `.nii` or `.nii.gz` gets the label volume that was meshed (cropped for the
     /// reduced variant, before coarsening and clean-up: `palpa mesh image` with the same
     /// --coarsen and a label map 1 flesh, 2 liver, 3 ribs, 4 viscera, 5 spine, 6.. tumours
-    /// reproduces the mesh). A directory (an existing one, a name ending in `/`, or a name
+    /// reproduces the mesh; with --skin fitted it is the body's labels on the plain grid, which
+    /// the mesh came from stretched). A directory (an existing one, a name ending in `/`, or a name
     /// with no extension) gets both, as `phantom.vtu` and `phantom.nii.gz`. Next to every
     /// output (in its directory) go `roi.json` and `roi.csv` (region-of-interest element ids
     /// and centroids, m) and `locations.json` (the 5x5 palpation raster and the test
