@@ -1,7 +1,7 @@
 //! The phantom's parameters as a plan and a dataset manifest record them (SI, JSON):
 //! [`PhantomRecord`], so that the phantom of a dataset can be rebuilt without its campaign file.
 
-use phantom::{Anatomy, GridParams, PhantomParams, Tumour};
+use phantom::{Anatomy, GridParams, PhantomParams, Skin, Tumour};
 use serde::{Deserialize, Serialize};
 
 /// The phantom parameters a campaign's plan and its dataset's manifest record.
@@ -21,8 +21,8 @@ pub struct PhantomRecord {
     /// Torso width, depth and length (m).
     pub torso_m: [f64; 3],
     /// `voxel` or `fitted` (`voxel` when absent: plans written before the fitted skin).
-    #[serde(default = "voxel", skip_serializing_if = "is_voxel")]
-    pub skin: String,
+    #[serde(default, skip_serializing_if = "Skin::is_voxel")]
+    pub skin: Skin,
     /// Voxels merged per element edge (1 when absent).
     #[serde(default = "one")]
     pub coarsen: usize,
@@ -39,14 +39,6 @@ pub struct PhantomRecord {
 
 fn one() -> usize {
     1
-}
-
-fn voxel() -> String {
-    "voxel".into()
-}
-
-fn is_voxel(s: &str) -> bool {
-    s == "voxel"
 }
 
 /// The raster of a [`PhantomRecord`].
@@ -80,7 +72,7 @@ impl PhantomRecord {
             respiratory_phase: p.respiratory_phase,
             max_liver_shift_m: p.max_liver_shift,
             torso_m: [p.torso_width, p.torso_depth, p.torso_length],
-            skin: p.skin.name().into(),
+            skin: p.skin,
             coarsen: p.mesh.coarsen,
             tumours: p.tumours.clone(),
             roi_radius_m: p.roi.radius,
@@ -112,10 +104,7 @@ impl PhantomRecord {
             ..Default::default()
         };
         [p.torso_width, p.torso_depth, p.torso_length] = self.torso_m;
-        p.skin = self
-            .skin
-            .parse()
-            .map_err(|e| format!("phantom parameters: `skin`: {e}"))?;
+        p.skin = self.skin;
         p.mesh.coarsen = self.coarsen;
         p.tumours = self.tumours.clone();
         p.roi.radius = self.roi_radius_m;

@@ -32,8 +32,9 @@ impl std::str::FromStr for Variant {
     }
 }
 
-/// How the anterior skin is meshed.
-#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+/// How the anterior skin is meshed (`voxel` or `fitted` in scenes and JSON records).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "lowercase")]
 pub enum Skin {
     /// Voxel steps, Taubin-smoothed (the paper's image-based mesh).
     #[default]
@@ -61,6 +62,11 @@ impl Skin {
             Skin::Voxel => "voxel",
             Skin::Fitted => "fitted",
         }
+    }
+
+    /// The default, voxel steps (records leave it out).
+    pub fn is_voxel(&self) -> bool {
+        *self == Skin::Voxel
     }
 }
 
