@@ -43,6 +43,23 @@ pub struct DoneMarker {
     pub notes: Vec<String>,
 }
 
+/// The finished runs in `out/runs/` whose label is not among `labels`, sorted: runs a campaign
+/// does not reuse. A design's labels are padded to the digits of its n (S01..S75, S001..S200),
+/// so runs copied from a smaller design to extend it across a power of ten are among them.
+pub fn stray_runs<'a>(out: &Path, labels: impl IntoIterator<Item = &'a str>) -> Vec<String> {
+    let known: std::collections::HashSet<&str> = labels.into_iter().collect();
+    let Ok(entries) = std::fs::read_dir(out.join("runs")) else {
+        return Vec::new();
+    };
+    let mut stray: Vec<String> = entries
+        .filter_map(|e| e.ok())
+        .filter_map(|e| e.file_name().into_string().ok())
+        .filter(|l| !known.contains(l.as_str()) && read_done(&run_dir(out, l)).is_some())
+        .collect();
+    stray.sort();
+    stray
+}
+
 /// The marker of a finished run in `dir`, if there is a readable one.
 pub fn read_done(dir: &Path) -> Option<DoneMarker> {
     let s = std::fs::read_to_string(dir.join(DONE_FILE)).ok()?;
@@ -143,4 +160,45 @@ fn read_run_files(dir: &Path) -> Result<RunSamples, String> {
         max_principal: p.stress,
         tensors,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{run_dir, stray_runs, write_done, DoneMarker};
+    use scene::run::RunStatus;
+
+    fn finish(out: &std::path::Path, label: &str) {
+        let dir = run_dir(out, label);
+        std::fs::create_dir_all(&dir).unwrap();
+        let m = DoneMarker {
+            label: label.into(),
+            index: 0,
+            status: RunStatus::Completed,
+            steps: 1,
+            simulated_time: 0.0,
+            wall_seconds: 0.0,
+            threads: 1,
+            samples: 0,
+            finished_unix: 0.0,
+            solver_version: String::new(),
+            notes: Vec::new(),
+        };
+        write_done(&dir, &m).unwrap();
+    }
+
+    /// Runs copied from a 75-point design (S01..) into a 200-point one (S001..) are named as
+    /// not reused; an unfinished stray run and the plan's own runs are not.
+    #[test]
+    fn stray_runs_are_the_finished_runs_the_plan_does_not_name() {
+        let t = tempfile::tempdir().unwrap();
+        assert!(stray_runs(t.path(), ["S001"]).is_empty());
+        for l in ["S01", "S02", "S001", "A"] {
+            finish(t.path(), l);
+        }
+        std::fs::create_dir_all(run_dir(t.path(), "S03")).unwrap();
+        assert_eq!(
+            stray_runs(t.path(), ["S001", "S002", "A"]),
+            vec!["S01".to_string(), "S02".to_string()]
+        );
+    }
 }

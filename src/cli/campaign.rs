@@ -159,6 +159,7 @@ fn run_campaign(a: &CampaignArgs) -> Result<(), String> {
 
     if !a.quiet || a.dry_run {
         print_header(&campaign, &phantom, shard, mine.len(), build_s);
+        print_stray(out, &campaign);
     }
     if a.dry_run {
         print_plan(&campaign, &locs, &mine, &done);
@@ -407,6 +408,19 @@ fn run_todo(
             }
             Ok(Some(ds))
         }
+    }
+}
+
+/// Name the finished runs in `out` that the plan does not, and so does not reuse (e.g. runs of a
+/// 75-point design copied to extend it to 200 points: S01.. there, S001.. here).
+fn print_stray(out: &Path, campaign: &campaign::Campaign) {
+    let stray = campaign::stray_runs(out, campaign.runs.iter().map(|r| r.label.as_str()));
+    if let (Some(first), Some(last)) = (stray.first(), stray.last()) {
+        println!(
+            "  note: {} holds {} finished run(s) this campaign does not name ({first} .. {last}); they are not reused (a design's labels have as many digits as its n)",
+            out.join("runs").display(),
+            stray.len()
+        );
     }
 }
 
