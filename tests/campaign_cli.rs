@@ -287,6 +287,29 @@ fn killed_campaign_resumes_without_losing_or_repeating_runs() {
         "{stdout}"
     );
     assert_eq!(std::fs::read(out.join("dataset.npz")).unwrap(), before);
+    // a finished run the plan does not name (as runs copied from a design with fewer digits
+    // are) is named on stderr, even with --quiet, and not reused
+    let stray = out.join("runs/P7");
+    std::fs::create_dir_all(&stray).unwrap();
+    for e in std::fs::read_dir(out.join("runs/P07")).unwrap() {
+        let e = e.unwrap();
+        std::fs::copy(e.path(), stray.join(e.file_name())).unwrap();
+    }
+    let o = palpa(&[
+        "campaign",
+        s(&file),
+        "--out",
+        s(&out),
+        "--resume",
+        "--quiet",
+    ]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        o.status.success()
+            && err.contains("holds 1 finished run(s) this campaign does not name (P7)"),
+        "{err}"
+    );
+    assert_eq!(std::fs::read(out.join("dataset.npz")).unwrap(), before);
 }
 
 #[test]

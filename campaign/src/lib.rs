@@ -118,7 +118,9 @@ pub use plan::{
     Campaign, CampaignLocation, CampaignPlan, PlaceKind, PlanLocation, PlanRoi, PlanRun,
     PlanSettings, PlannedRun, Split,
 };
-pub use run_files::{read_done, read_run, run_dir, stray_runs, write_done, DoneMarker, RunSamples};
+pub use run_files::{
+    read_done, read_run, run_dir, runs_dir, stray_runs, write_done, DoneMarker, RunSamples,
+};
 pub use shard::{in_shard, parse_shard, recorded_shard, resolve_shard, shard_in};
 pub use spec::{
     CampaignSpec, HandSpec, IndentationSpec, LocationEntry, LocationsSpec, NamedPoint, OneOrMany,

@@ -1,6 +1,7 @@
 //! The files of one run in a campaign directory: `runs/<label>/`, its marker of a finished run
 //! ([`DoneMarker`], `done.json`) and its samples ([`RunSamples`]: `probe.csv`,
-//! `probe_stress.csv`, `history.csv`).
+//! `probe_stress.csv`, `history.csv`); and the finished runs in `runs/` that a plan does not
+//! name ([`stray_runs`]), which a campaign does not reuse.
 
 use crate::DONE_FILE;
 use scene::palpation::read_probe;
@@ -11,9 +12,14 @@ use solver::output::filter::{moving_average_at, FORCE_FILTER};
 use solver::output::history::{column, read_history};
 use std::path::{Path, PathBuf};
 
+/// Directory of the runs in campaign directory `out`.
+pub fn runs_dir(out: &Path) -> PathBuf {
+    out.join("runs")
+}
+
 /// Directory of run `label` in campaign directory `out`.
 pub fn run_dir(out: &Path, label: &str) -> PathBuf {
-    out.join("runs").join(label)
+    runs_dir(out).join(label)
 }
 
 /// The marker of a finished run (`done.json`), written last and atomically.
@@ -45,10 +51,11 @@ pub struct DoneMarker {
 
 /// The finished runs in `out/runs/` whose label is not among `labels`, sorted: runs a campaign
 /// does not reuse. A design's labels are padded to the digits of its n (S01..S75, S001..S200),
-/// so runs copied from a smaller design to extend it across a power of ten are among them.
+/// so runs copied from a smaller design to extend it across a power of ten are among them, as
+/// are the runs of a location since removed from the campaign file.
 pub fn stray_runs<'a>(out: &Path, labels: impl IntoIterator<Item = &'a str>) -> Vec<String> {
     let known: std::collections::HashSet<&str> = labels.into_iter().collect();
-    let Ok(entries) = std::fs::read_dir(out.join("runs")) else {
+    let Ok(entries) = std::fs::read_dir(runs_dir(out)) else {
         return Vec::new();
     };
     let mut stray: Vec<String> = entries
@@ -192,13 +199,13 @@ mod tests {
     fn stray_runs_are_the_finished_runs_the_plan_does_not_name() {
         let t = tempfile::tempdir().unwrap();
         assert!(stray_runs(t.path(), ["S001"]).is_empty());
-        for l in ["S01", "S02", "S001", "A"] {
+        for l in ["S10", "S01", "S02", "S001", "A"] {
             finish(t.path(), l);
         }
         std::fs::create_dir_all(run_dir(t.path(), "S03")).unwrap();
         assert_eq!(
             stray_runs(t.path(), ["S001", "S002", "A"]),
-            vec!["S01".to_string(), "S02".to_string()]
+            vec!["S01".to_string(), "S02".to_string(), "S10".to_string()]
         );
     }
 }

@@ -159,8 +159,8 @@ fn run_campaign(a: &CampaignArgs) -> Result<(), String> {
 
     if !a.quiet || a.dry_run {
         print_header(&campaign, &phantom, shard, mine.len(), build_s);
-        print_stray(out, &campaign);
     }
+    print_stray(out, &campaign);
     if a.dry_run {
         print_plan(&campaign, &locs, &mine, &done);
         return Ok(());
@@ -411,17 +411,24 @@ fn run_todo(
     }
 }
 
-/// Name the finished runs in `out` that the plan does not, and so does not reuse (e.g. runs of a
-/// 75-point design copied to extend it to 200 points: S01.. there, S001.. here).
+/// Name on stderr, `--quiet` or not, the finished runs in `out` that the plan does not name and
+/// so does not reuse (e.g. runs of a 75-point design copied to extend it to 200 points: S01..
+/// there, S001.. here). The whole campaign's labels, not the shard's: a shard's directory may
+/// hold the other shards' runs.
 fn print_stray(out: &Path, campaign: &campaign::Campaign) {
     let stray = campaign::stray_runs(out, campaign.runs.iter().map(|r| r.label.as_str()));
-    if let (Some(first), Some(last)) = (stray.first(), stray.last()) {
-        println!(
-            "  note: {} holds {} finished run(s) this campaign does not name ({first} .. {last}); they are not reused (a design's labels have as many digits as its n)",
-            out.join("runs").display(),
-            stray.len()
-        );
+    if stray.is_empty() {
+        return;
     }
+    let mut names = stray.iter().take(3).cloned().collect::<Vec<_>>().join(", ");
+    if stray.len() > 3 {
+        names.push_str(", ...");
+    }
+    eprintln!(
+        "note: {} holds {} finished run(s) this campaign does not name ({names}): they are not reused; a design's labels have as many digits as its n, so to reuse runs of a smaller design rename them to this plan's labels (docs/campaigns.md, \"Designs and adaptive sampling\")",
+        campaign::runs_dir(out).display(),
+        stray.len()
+    );
 }
 
 /// The campaign's first line: runs, locations, shard, phantom and its build time.
