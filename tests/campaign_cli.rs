@@ -464,6 +464,23 @@ fn shipped_profiles_resolve_and_bad_keys_are_named() {
     );
     assert_eq!(xy(&fitted3, 'S'), s3);
     assert_eq!(xy(&fitted3, 'T'), xy(&sobol3, 'T'));
+    // and its adaptive design starts from the same first 10 points, with the fitted skin
+    let fitted_adaptive3 = dry_run("campaign-adaptive-3mm-fitted.toml");
+    assert!(
+        fitted_adaptive3.contains("25 runs (25 locations: 10 train, 15 test)"),
+        "{fitted_adaptive3}"
+    );
+    assert_eq!(xy(&fitted_adaptive3, 'S'), s3[..10]);
+    assert_eq!(xy(&fitted_adaptive3, 'T'), xy(&sobol3, 'T'));
+    // the fitted skin's mesh, not the voxel skin's: the header's hexahedra
+    let hexes = |t: &str| {
+        t.lines()
+            .next()
+            .and_then(|l| l.split(" hexahedra").next()?.rsplit(' ').next())
+            .map(String::from)
+    };
+    assert_eq!(hexes(&fitted_adaptive3), hexes(&fitted3));
+    assert_ne!(hexes(&fitted3), hexes(&sobol3));
     // the respiratory design: Sobol over (x, y, phase), whose (x, y) are the plain design's
     let breath = dry_run("campaign-respiration-5mm.toml");
     assert!(
