@@ -20,7 +20,9 @@
 //! - a respiratory campaign (`[locations] phases`) has the phase as its sixth input column,
 //!   reads each run's ROI through the points carried with the liver, and at the reference
 //!   phase gives the plain campaign's numbers bit for bit; its model takes the phase (in
-//!   `palpa predict --phase` and in `palpa serve`'s phase message).
+//!   `palpa predict --phase` and in `palpa serve`'s phase message);
+//! - finished runs the plan does not name are named and not reused; `palpa front` reads a
+//!   campaign still running from its finished runs, as the finished campaign at that count.
 
 use std::path::Path;
 use std::process::{Command, Stdio};
@@ -715,4 +717,55 @@ fn phase_model_takes_the_phase(tmp: &Path, breath: &Path, plain: &Path, d: &Data
     let r = stream(&flat, &line(", \"phase\": 0.5"));
     let e = r[0]["error"].as_str().unwrap_or_default();
     assert!(e.contains("takes x, y and force only"), "{r:?}");
+}
+
+/// `palpa front` on a campaign still running (no dataset.npz) reads its finished runs: the
+/// training locations before the first unfinished one, and every held-out one; its row at
+/// that count equals the finished campaign's. An unfinished held-out run is named.
+#[test]
+fn front_reads_the_finished_runs_of_a_running_campaign() {
+    let tmp = tempfile::tempdir().unwrap();
+    let file = tiny(tmp.path());
+    let out = tmp.path().join("c");
+    ok(&["campaign", s(&file), "--out", s(&out), "--quiet"]);
+    let front = |name: &str| {
+        let dir = tmp.path().join(name);
+        let o = palpa(&[
+            "front",
+            &format!("d={}", s(&out)),
+            "--runs",
+            "1,2",
+            "--out",
+            s(&dir),
+        ]);
+        let csv = std::fs::read_to_string(dir.join("front.csv")).unwrap_or_default();
+        // the rows without their last cell, the GP's training time
+        let rows: Vec<String> = csv
+            .lines()
+            .skip(1)
+            .map(|l| l.rsplit_once(',').unwrap().0.to_string())
+            .collect();
+        (o, rows)
+    };
+    let (o, whole) = front("whole");
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    assert_eq!(whole.len(), 2, "{whole:?}");
+    // the campaign stopped with P12, its second training location, unfinished
+    std::fs::remove_file(out.join("dataset.npz")).unwrap();
+    std::fs::remove_file(out.join("runs/P12/done.json")).unwrap();
+    let (o, running) = front("running");
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        o.status.success() && err.contains("the first 1 of 2 training locations"),
+        "{err}"
+    );
+    assert_eq!(running, whole[..1], "{err}");
+    // without its held-out run there is nothing to score: the error names it
+    std::fs::remove_file(out.join("runs/A/done.json")).unwrap();
+    let (o, _) = front("no-test");
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        !o.status.success() && err.contains("held-out run(s) not finished: A"),
+        "{err}"
+    );
 }

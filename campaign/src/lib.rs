@@ -87,6 +87,7 @@ mod assemble;
 mod design;
 mod dir;
 mod execute;
+mod finished;
 mod json_file;
 mod label;
 mod merge;
@@ -109,6 +110,7 @@ pub use dir::{
     CampaignDir,
 };
 pub use execute::{execute, run_one, Parallelism, Report, RunEvent};
+pub use finished::{assemble_finished, FinishedPrefix};
 pub use json_file::{read_json, write_json};
 pub use merge::{merge, MergeReport};
 pub use outcome::{finish, Outcome};

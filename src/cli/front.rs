@@ -11,7 +11,8 @@
 //! C, and over the other test locations (the seeded random ones); the Fit at the paper's time
 //! stamps; the GP's 95 % interval coverage; the training runs' solver cost (their run wall
 //! time times their threads, from each run's `done.json`, in core-hours) and the training
-//! time. `--recover H` trains and scores on the recovered stress target
+//! time. A campaign still running (no `dataset.npz` yet) is read from its finished runs
+//! ([`campaign::assemble_finished`]). `--recover H` trains and scores on the recovered stress target
 //! ([`surrogate::recovery`]) instead of the element stress. Written as `front.csv`, `front.md` and `front.png` (Fit against runs, one line per
 //! design), each atomically.
 
@@ -23,8 +24,10 @@ use surrogate::{Dataset, ModelKind, Split, TrainOptions};
 /// `palpa front`'s arguments.
 #[derive(clap::Args)]
 pub struct FrontArgs {
-    /// Designs as NAME=DIR: campaign directories holding dataset.npz and runs/; NAME=DIR:N,N
-    /// gives that design its own run counts (e.g. grid=DIR:25, the paper's whole raster).
+    /// Designs as NAME=DIR: campaign directories holding dataset.npz and runs/ (one still
+    /// running, without dataset.npz, is read from its finished runs: its training locations
+    /// up to the first unfinished one, and all held-out ones); NAME=DIR:N,N gives that design
+    /// its own run counts (e.g. grid=DIR:25, the paper's whole raster).
     #[arg(required = true, value_name = "NAME=DIR[:N,...]")]
     pub designs: Vec<String>,
     /// Training run counts (each at most a design's training locations; larger ones are
@@ -96,14 +99,16 @@ pub fn run(a: &FrontArgs) -> Result<(), String> {
         if designs.iter().any(|x| x.0 == name) {
             return Err(format!("design `{name}` is named twice"));
         }
-        check_dataset_path(&dir)?;
+        if !dir.join(campaign::CAMPAIGN_FILE).is_file() || dir.join("dataset.npz").is_file() {
+            check_dataset_path(&dir)?;
+        }
         designs.push((name, dir, runs));
     }
     std::fs::create_dir_all(&a.out)
         .map_err(|e| format!("{}: cannot create: {e}", a.out.display()))?;
     let mut rows = Vec::new();
     for (name, dir, runs) in &designs {
-        let data = Dataset::read(dir).map_err(|e| format!("dataset {}: {e}", dir.display()))?;
+        let data = read_design(name, dir)?;
         let order = data.training_location_order();
         for &n in runs {
             if n > order.len() {
@@ -134,6 +139,22 @@ pub fn run(a: &FrontArgs) -> Result<(), String> {
         }
     }
     write_outputs(&a.out, &rows)
+}
+
+/// A design's dataset: its `dataset.npz`, or, for a campaign still running (no dataset yet),
+/// the dataset of its finished runs ([`campaign::assemble_finished`]), said on stderr.
+fn read_design(name: &str, dir: &Path) -> Result<Dataset, String> {
+    if !dir.join("dataset.npz").is_file() && dir.join(campaign::CAMPAIGN_FILE).is_file() {
+        let f = campaign::assemble_finished(dir)?;
+        eprintln!(
+            "  {name}: {} has no dataset.npz yet: reading its finished runs, the first {} of {} training locations and every held-out one",
+            dir.display(),
+            f.training_locations,
+            f.planned_training_locations
+        );
+        return Ok(f.dataset);
+    }
+    Dataset::read(dir).map_err(|e| format!("dataset {}: {e}", dir.display()))
 }
 
 /// `NAME=DIR` or `NAME=DIR:N,N` (the design's own run counts; a DIR ending in `:digits` is
