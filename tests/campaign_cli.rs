@@ -751,12 +751,21 @@ fn front_reads_the_finished_runs_of_a_running_campaign() {
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     assert_eq!(whole.len(), 2, "{whole:?}");
     // the campaign stopped with P12, its second training location, unfinished
-    std::fs::remove_file(out.join("dataset.npz")).unwrap();
-    std::fs::remove_file(out.join("runs/P12/done.json")).unwrap();
+    for f in [
+        "dataset.npz",
+        "manifest.json",
+        "dataset.json",
+        "runs/P12/done.json",
+    ] {
+        let _ = std::fs::remove_file(out.join(f));
+    }
     let (o, running) = front("running");
     let err = String::from_utf8_lossy(&o.stderr);
     assert!(
-        o.status.success() && err.contains("the first 1 of 2 training locations"),
+        o.status.success()
+            && err.contains("the first 1 of 2 training locations")
+            && err.contains("it stops at P12")
+            && err.contains("2 runs skipped (only the first 1 training locations are finished)"),
         "{err}"
     );
     assert_eq!(running, whole[..1], "{err}");

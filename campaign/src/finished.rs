@@ -1,12 +1,14 @@
 //! The dataset of a campaign's finished runs, read while the campaign is still running (for
 //! `palpa front` on a design not yet complete). A front trains on a design's *first* n
 //! training locations, so the dataset holds the training locations in plan order up to the
-//! first one with an unfinished run, and every held-out run, which must all be finished.
+//! first one with an unfinished run, and every held-out run, which must all be finished (a
+//! campaign runs its held-out locations after its training ones, so they are finished when it
+//! was extended from a finished one, or at its end).
 
 use crate::assemble::assemble;
 use crate::dir::read_campaign_dir;
-use crate::run_files::{read_done, run_dir};
-use std::collections::HashSet;
+use crate::run_files::is_finished;
+use std::collections::HashMap;
 use std::path::Path;
 use surrogate::{Dataset, Split};
 
@@ -18,60 +20,129 @@ pub struct FinishedPrefix {
     pub training_locations: usize,
     /// Training locations in the plan.
     pub planned_training_locations: usize,
+    /// The first unfinished training run, where the prefix stops (`None` when all finished).
+    pub stopped_at: Option<String>,
+    /// Finished training runs after it, not read.
+    pub finished_after: usize,
 }
 
-/// Assemble the dataset of `out`'s finished runs: the held-out runs and the training runs of
-/// the plan's training locations before the first location with an unfinished run. An error
-/// names the held-out runs not finished.
-pub fn assemble_finished(out: &Path) -> Result<FinishedPrefix, String> {
-    let plan = read_campaign_dir(out)?.plan()?;
-    let finished = |label: &str| read_done(&run_dir(out, label)).is_some();
-    let split_of = |loc: &str| {
-        plan.locations
-            .iter()
-            .find(|l| l.label == loc)
-            .map(|l| l.split)
-    };
-    let unfinished_test: Vec<&str> = plan
-        .runs
+/// The runs to read, given each run's (label, location), each location's split and which runs
+/// are finished: the runs of the training locations (in the order of their first run) before
+/// the first location with an unfinished run, and every held-out run. The prefix's length,
+/// the run it stops at and the finished training runs after it; or the unfinished held-out
+/// runs.
+pub fn finished_prefix(
+    runs: &[(&str, &str)],
+    split: &HashMap<&str, Split>,
+    finished: impl Fn(&str) -> bool,
+) -> Result<(Vec<String>, usize, Option<String>, usize), Vec<String>> {
+    let is_test = |loc: &str| split.get(loc) == Some(&Split::Test);
+    let unfinished_test: Vec<String> = runs
         .iter()
-        .filter(|r| split_of(&r.location) == Some(Split::Test) && !finished(&r.label))
-        .map(|r| r.label.as_str())
+        .filter(|(l, loc)| is_test(loc) && !finished(l))
+        .map(|(l, _)| l.to_string())
         .collect();
     if !unfinished_test.is_empty() {
+        return Err(unfinished_test);
+    }
+    let stop = runs
+        .iter()
+        .find(|(l, loc)| !is_test(loc) && !finished(l))
+        .map(|&(l, loc)| (l, loc));
+    // the training locations in the order of their first run, up to the stopping one
+    let mut kept: Vec<&str> = Vec::new();
+    for (_, loc) in runs.iter().filter(|(_, loc)| !is_test(loc)) {
+        if stop.is_some_and(|(_, s)| s == *loc) {
+            break;
+        }
+        if !kept.contains(loc) {
+            kept.push(loc);
+        }
+    }
+    let labels = runs
+        .iter()
+        .filter(|(_, loc)| is_test(loc) || kept.contains(loc))
+        .map(|(l, _)| l.to_string())
+        .collect();
+    let after = runs
+        .iter()
+        .filter(|(l, loc)| !is_test(loc) && !kept.contains(loc) && finished(l))
+        .count();
+    Ok((labels, kept.len(), stop.map(|(l, _)| l.to_string()), after))
+}
+
+/// Assemble the dataset of `out`'s finished runs ([`finished_prefix`]). An error names the
+/// held-out runs not finished, or refuses a shard's directory (the other shards' runs are
+/// elsewhere: merge them first).
+pub fn assemble_finished(out: &Path) -> Result<FinishedPrefix, String> {
+    let cd = read_campaign_dir(out)?;
+    if let Some((i, n)) = cd.shard {
         return Err(format!(
-            "{}: held-out run(s) not finished: {} (continue the campaign with --resume)",
-            out.display(),
-            unfinished_test.join(", ")
+            "{}: holds shard {i}/{n} of a campaign; join the shards with `palpa campaign merge` and give the merged directory",
+            out.display()
         ));
     }
-    // the training locations in plan order, cut before the first with an unfinished run
-    let training: Vec<&str> = plan
+    let plan = cd.plan()?;
+    let split: HashMap<&str, Split> = plan
         .locations
         .iter()
-        .filter(|l| l.split == Split::Train)
-        .map(|l| l.label.as_str())
+        .map(|l| (l.label.as_str(), l.split))
         .collect();
-    let complete = |loc: &str| {
-        plan.runs
-            .iter()
-            .filter(|r| r.location == loc)
-            .all(|r| finished(&r.label))
-    };
-    let n = training.iter().take_while(|l| complete(l)).count();
-    let keep: HashSet<&str> = training[..n].iter().copied().collect();
-    let labels: Vec<String> = plan
+    let runs: Vec<(&str, &str)> = plan
         .runs
         .iter()
-        .filter(|r| {
-            keep.contains(r.location.as_str()) || split_of(&r.location) == Some(Split::Test)
-        })
-        .map(|r| r.label.clone())
+        .map(|r| (r.label.as_str(), r.location.as_str()))
         .collect();
-    let dataset = assemble(&plan, &labels, |l| run_dir(out, l))?;
+    let (labels, n, stopped_at, finished_after) =
+        finished_prefix(&runs, &split, |l| is_finished(out, l)).map_err(|missing| {
+            format!(
+                "{}: held-out run(s) not finished: {} (a campaign runs its held-out locations last; continue it with --resume)",
+                out.display(),
+                missing.join(", ")
+            )
+        })?;
+    let dataset = assemble(&plan, &labels, |l| crate::run_dir(out, l))?;
     Ok(FinishedPrefix {
         dataset,
         training_locations: n,
-        planned_training_locations: training.len(),
+        planned_training_locations: split.values().filter(|&&s| s == Split::Train).count(),
+        stopped_at,
+        finished_after,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::finished_prefix;
+    use std::collections::HashMap;
+    use surrogate::Split;
+
+    /// Two depths a location; a held-out location between training ones (an adaptive plan's
+    /// layout). S2's second run is unfinished, so the prefix is S1 alone although S3 is
+    /// finished; every held-out run is read; an unfinished held-out run is named.
+    #[test]
+    fn the_prefix_stops_at_the_first_location_with_an_unfinished_run() {
+        let runs = [
+            ("S1-d1", "S1"),
+            ("S1-d2", "S1"),
+            ("A-d1", "A"),
+            ("S2-d1", "S2"),
+            ("S2-d2", "S2"),
+            ("S3-d1", "S3"),
+            ("S3-d2", "S3"),
+        ];
+        let split = HashMap::from([
+            ("S1", Split::Train),
+            ("S2", Split::Train),
+            ("S3", Split::Train),
+            ("A", Split::Test),
+        ]);
+        let (labels, n, stop, after) = finished_prefix(&runs, &split, |l| l != "S2-d2").unwrap();
+        assert_eq!(labels, ["S1-d1", "S1-d2", "A-d1"]);
+        assert_eq!((n, stop.as_deref(), after), (1, Some("S2-d2"), 3));
+        let (labels, n, stop, after) = finished_prefix(&runs, &split, |_| true).unwrap();
+        assert_eq!((labels.len(), n, stop, after), (7, 3, None, 0));
+        let missing = finished_prefix(&runs, &split, |l| l != "A-d1").unwrap_err();
+        assert_eq!(missing, ["A-d1"]);
+    }
 }

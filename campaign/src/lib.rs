@@ -110,7 +110,7 @@ pub use dir::{
     CampaignDir,
 };
 pub use execute::{execute, run_one, Parallelism, Report, RunEvent};
-pub use finished::{assemble_finished, FinishedPrefix};
+pub use finished::{assemble_finished, finished_prefix, FinishedPrefix};
 pub use json_file::{read_json, write_json};
 pub use merge::{merge, MergeReport};
 pub use outcome::{finish, Outcome};
@@ -121,7 +121,8 @@ pub use plan::{
     PlanSettings, PlannedRun, Split,
 };
 pub use run_files::{
-    read_done, read_run, run_dir, runs_dir, stray_runs, write_done, DoneMarker, RunSamples,
+    is_finished, read_done, read_run, run_dir, runs_dir, stray_runs, write_done, DoneMarker,
+    RunSamples,
 };
 pub use shard::{in_shard, parse_shard, recorded_shard, resolve_shard, shard_in};
 pub use spec::{

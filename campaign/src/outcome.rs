@@ -5,7 +5,7 @@
 use crate::assemble::{assemble, write_dataset};
 use crate::execute::Report;
 use crate::plan::{CampaignPlan, PlannedRun};
-use crate::run_files::{read_done, run_dir};
+use crate::run_files::{is_finished, run_dir};
 use std::path::Path;
 use surrogate::Dataset;
 
@@ -38,7 +38,7 @@ pub fn finish(
     }
     let missing: Vec<String> = mine
         .iter()
-        .filter(|r| read_done(&run_dir(out, &r.label)).is_none())
+        .filter(|r| !is_finished(out, &r.label))
         .map(|r| r.label.clone())
         .collect();
     if !missing.is_empty() {

@@ -61,10 +61,15 @@ pub fn stray_runs<'a>(out: &Path, labels: impl IntoIterator<Item = &'a str>) -> 
     let mut stray: Vec<String> = entries
         .filter_map(|e| e.ok())
         .filter_map(|e| e.file_name().into_string().ok())
-        .filter(|l| !known.contains(l.as_str()) && read_done(&run_dir(out, l)).is_some())
+        .filter(|l| !known.contains(l.as_str()) && is_finished(out, l))
         .collect();
     stray.sort();
     stray
+}
+
+/// Whether run `label` of the campaign in `out` is finished (has a readable `done.json`).
+pub fn is_finished(out: &Path, label: &str) -> bool {
+    read_done(&run_dir(out, label)).is_some()
 }
 
 /// The marker of a finished run in `dir`, if there is a readable one.

@@ -27,8 +27,8 @@
 
 use super::progress::{stop_flag, time_bar};
 use campaign::{
-    read_done, resolve_shard, run_dir, AdaptiveRecord, Campaign, CampaignSpec, Outcome,
-    Parallelism, PlannedRun, Report, RunEvent, Split,
+    resolve_shard, AdaptiveRecord, Campaign, CampaignSpec, Outcome, Parallelism, PlannedRun,
+    Report, RunEvent, Split,
 };
 use phantom::Phantom;
 use std::path::{Path, PathBuf};
@@ -153,7 +153,7 @@ fn run_campaign(a: &CampaignArgs) -> Result<(), String> {
     let out = &a.out;
     let done: Vec<bool> = mine
         .iter()
-        .map(|r| read_done(&run_dir(out, &r.label)).is_some())
+        .map(|r| campaign::is_finished(out, &r.label))
         .collect();
     let n_done = done.iter().filter(|&&d| d).count();
 

@@ -26,7 +26,8 @@ use surrogate::{Dataset, ModelKind, Split, TrainOptions};
 pub struct FrontArgs {
     /// Designs as NAME=DIR: campaign directories holding dataset.npz and runs/ (one still
     /// running, without dataset.npz, is read from its finished runs: its training locations
-    /// up to the first unfinished one, and all held-out ones); NAME=DIR:N,N gives that design
+    /// up to the first unfinished one; its held-out runs, which a campaign runs last, must be
+    /// finished); NAME=DIR:N,N gives that design
     /// its own run counts (e.g. grid=DIR:25, the paper's whole raster).
     #[arg(required = true, value_name = "NAME=DIR[:N,...]")]
     pub designs: Vec<String>,
@@ -93,29 +94,36 @@ pub fn run(a: &FrontArgs) -> Result<(), String> {
     if a.runs.contains(&0) {
         return Err("--runs: counts must be at least 1".into());
     }
-    let mut designs: Vec<(String, PathBuf, Vec<usize>)> = Vec::new();
+    // every design read before any is trained, so that a bad one stops the front at once
+    let mut designs: Vec<(String, PathBuf, Vec<usize>, Dataset, bool)> = Vec::new();
     for d in &a.designs {
         let (name, dir, runs) = parse_design(d, &a.runs)?;
         if designs.iter().any(|x| x.0 == name) {
             return Err(format!("design `{name}` is named twice"));
         }
-        if !dir.join(campaign::CAMPAIGN_FILE).is_file() || dir.join("dataset.npz").is_file() {
+        let running = running_campaign(&dir);
+        if !running {
             check_dataset_path(&dir)?;
         }
-        designs.push((name, dir, runs));
+        let data = read_design(&name, &dir, running)?;
+        designs.push((name, dir, runs, data, running));
     }
     std::fs::create_dir_all(&a.out)
         .map_err(|e| format!("{}: cannot create: {e}", a.out.display()))?;
     let mut rows = Vec::new();
-    for (name, dir, runs) in &designs {
-        let data = read_design(name, dir)?;
+    for (name, dir, runs, data, running) in &designs {
         let order = data.training_location_order();
         for &n in runs {
             if n > order.len() {
-                eprintln!(
-                    "  {name}: {n} runs skipped (the campaign has {} training locations)",
-                    order.len()
-                );
+                let why = if *running {
+                    format!(
+                        "only the first {} training locations are finished",
+                        order.len()
+                    )
+                } else {
+                    format!("the campaign has {} training locations", order.len())
+                };
+                eprintln!("  {name}: {n} runs skipped ({why})");
                 continue;
             }
             let selection = surrogate::TrainingSelection {
@@ -124,7 +132,7 @@ pub fn run(a: &FrontArgs) -> Result<(), String> {
                 recovery_width,
                 ignore_phase: a.target.ignore_phase,
             };
-            let row = point(name, dir, &data, &order[..n], &selection)?;
+            let row = point(name, dir, data, &order[..n], &selection)?;
             println!(
                 "  {name:<10} {n:>4} runs, {:.3} core-h: held-out Fit {:.4} (A, B, C {}, others {}), at the paper's stamps {:.4}, 95 % coverage {}, trained in {:.1} s",
                 row.core_hours,
@@ -138,23 +146,54 @@ pub fn run(a: &FrontArgs) -> Result<(), String> {
             rows.push(row);
         }
     }
+    if rows.is_empty() {
+        return Err(format!(
+            "no point of the front: every --runs count ({}) exceeds the designs' training locations",
+            a.runs
+                .iter()
+                .map(|n| n.to_string())
+                .collect::<Vec<_>>()
+                .join(", ")
+        ));
+    }
     write_outputs(&a.out, &rows)
 }
 
-/// A design's dataset: its `dataset.npz`, or, for a campaign still running (no dataset yet),
-/// the dataset of its finished runs ([`campaign::assemble_finished`]), said on stderr.
-fn read_design(name: &str, dir: &Path) -> Result<Dataset, String> {
-    if !dir.join("dataset.npz").is_file() && dir.join(campaign::CAMPAIGN_FILE).is_file() {
-        let f = campaign::assemble_finished(dir)?;
-        eprintln!(
-            "  {name}: {} has no dataset.npz yet: reading its finished runs, the first {} of {} training locations and every held-out one",
-            dir.display(),
-            f.training_locations,
-            f.planned_training_locations
-        );
-        return Ok(f.dataset);
+/// Whether `dir` is a campaign still running: its `campaign.json` without a `dataset.npz`.
+fn running_campaign(dir: &Path) -> bool {
+    dir.join(campaign::CAMPAIGN_FILE).is_file() && !dir.join("dataset.npz").is_file()
+}
+
+/// A design's dataset: its `dataset.npz`, or, for a campaign still running, the dataset of its
+/// finished runs ([`campaign::assemble_finished`]), said on stderr. A shard's directory is
+/// refused: its dataset lacks the other shards' runs.
+fn read_design(name: &str, dir: &Path, running: bool) -> Result<Dataset, String> {
+    if !running {
+        if dir.join(campaign::CAMPAIGN_FILE).is_file() {
+            if let Some((i, n)) = campaign::read_campaign_dir(dir)?.shard {
+                return Err(format!(
+                    "{name}: {} holds shard {i}/{n} of a campaign; join the shards with `palpa campaign merge` and give the merged directory",
+                    dir.display()
+                ));
+            }
+        }
+        return Dataset::read(dir).map_err(|e| format!("dataset {}: {e}", dir.display()));
     }
-    Dataset::read(dir).map_err(|e| format!("dataset {}: {e}", dir.display()))
+    let f = campaign::assemble_finished(dir).map_err(|e| format!("{name}: {e}"))?;
+    let cut = match &f.stopped_at {
+        Some(run) => format!(
+            "; it stops at {run}, not finished ({} later finished training run(s) not used)",
+            f.finished_after
+        ),
+        None => String::new(),
+    };
+    eprintln!(
+        "  {name}: {} has no dataset.npz yet: reading its finished runs, the first {} of {} training locations and every held-out one{cut}",
+        dir.display(),
+        f.training_locations,
+        f.planned_training_locations
+    );
+    Ok(f.dataset)
 }
 
 /// `NAME=DIR` or `NAME=DIR:N,N` (the design's own run counts; a DIR ending in `:digits` is
