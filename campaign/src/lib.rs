@@ -12,6 +12,8 @@
 //! when its `done.json` ([`DoneMarker`]) exists, written atomically after everything else. A
 //! directory without it is an interrupted or failed run and is redone from scratch. The
 //! finished runs make the dataset ([`assemble`]); the shards of a campaign join by [`merge`].
+//! While a campaign runs, [`assemble_finished`] reads the dataset of its finished prefix (for
+//! `palpa front`), and [`stray_runs`] names finished runs its plan does not name.
 //!
 //! # The file
 //! Every key is optional; the defaults are the paper's protocol (`docs/paper.md`):
