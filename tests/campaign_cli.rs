@@ -420,16 +420,7 @@ fn shipped_profiles_resolve_and_bad_keys_are_named() {
     assert!(sx.iter().all(|y| (165.0..=225.0).contains(y)), "{sx:?}");
     // the 3 mm front's profile: the same sequence, 200 points, its first 100 the 5 mm front's,
     // and the same held-out points
-    let xy = |table: &str, prefix: char| -> Vec<(String, String)> {
-        table
-            .lines()
-            .filter(|l| l.trim_start().starts_with(prefix))
-            .filter_map(|l| {
-                let w: Vec<&str> = l.split_whitespace().collect();
-                Some((w.get(3)?.to_string(), w.get(4)?.to_string()))
-            })
-            .collect()
-    };
+    let xy = profile_points;
     let sobol3 = dry_run("campaign-sobol-3mm.toml");
     assert!(
         sobol3.contains("215 runs (215 locations: 200 train, 15 test)")
@@ -458,31 +449,7 @@ fn shipped_profiles_resolve_and_bad_keys_are_named() {
         assert_eq!(xy(table, 'T'), xy(&sobol3, 'T'));
     }
     assert_eq!(xy(&adaptive3, 'S'), s3[..10]);
-    // the fitted-skin front: the 3 mm front's 200 points and its held-out points
-    let fitted3 = dry_run("campaign-sobol-3mm-fitted.toml");
-    assert!(
-        fitted3.contains("215 runs (215 locations: 200 train, 15 test)"),
-        "{fitted3}"
-    );
-    assert_eq!(xy(&fitted3, 'S'), s3);
-    assert_eq!(xy(&fitted3, 'T'), xy(&sobol3, 'T'));
-    // and its adaptive design starts from the same first 10 points, with the fitted skin
-    let fitted_adaptive3 = dry_run("campaign-adaptive-3mm-fitted.toml");
-    assert!(
-        fitted_adaptive3.contains("25 runs (25 locations: 10 train, 15 test)"),
-        "{fitted_adaptive3}"
-    );
-    assert_eq!(xy(&fitted_adaptive3, 'S'), s3[..10]);
-    assert_eq!(xy(&fitted_adaptive3, 'T'), xy(&sobol3, 'T'));
-    // the fitted skin's mesh, not the voxel skin's: the header's hexahedra
-    let hexes = |t: &str| {
-        t.lines()
-            .next()
-            .and_then(|l| l.split(" hexahedra").next()?.rsplit(' ').next())
-            .map(String::from)
-    };
-    assert_eq!(hexes(&fitted_adaptive3), hexes(&fitted3));
-    assert_ne!(hexes(&fitted3), hexes(&sobol3));
+    fitted_profiles_match_the_3mm_front(&dry_run, &sobol3, &s3);
     // the respiratory design: Sobol over (x, y, phase), whose (x, y) are the plain design's
     let breath = dry_run("campaign-respiration-5mm.toml");
     assert!(
@@ -508,6 +475,55 @@ fn shipped_profiles_resolve_and_bad_keys_are_named() {
 
 /// Issue 29: `sample_interval = "1e-320 s"` was accepted and the campaign never ended; a run
 /// with more samples than the limit is refused, naming the key, unless the limit is raised.
+/// The (x, y) cells of a dry run's rows whose label starts with `prefix`.
+fn profile_points(table: &str, prefix: char) -> Vec<(String, String)> {
+    table
+        .lines()
+        .filter(|l| l.trim_start().starts_with(prefix))
+        .filter_map(|l| {
+            let w: Vec<&str> = l.split_whitespace().collect();
+            Some((w.get(3)?.to_string(), w.get(4)?.to_string()))
+        })
+        .collect()
+}
+
+/// The fitted-skin profiles: the Sobol one holds the 3 mm front's 200 points (`s3`) and its
+/// held-out points; the adaptive one starts from the first 10, on the same fitted mesh.
+fn fitted_profiles_match_the_3mm_front(
+    dry_run: &dyn Fn(&str) -> String,
+    sobol3: &str,
+    s3: &[(String, String)],
+) {
+    // the fitted-skin front: the 3 mm front's 200 points and its held-out points
+    let fitted3 = dry_run("campaign-sobol-3mm-fitted.toml");
+    assert!(
+        fitted3.contains("215 runs (215 locations: 200 train, 15 test)"),
+        "{fitted3}"
+    );
+    assert_eq!(profile_points(&fitted3, 'S'), s3);
+    assert_eq!(profile_points(&fitted3, 'T'), profile_points(sobol3, 'T'));
+    // and its adaptive design starts from the same first 10 points, with the fitted skin
+    let fitted_adaptive3 = dry_run("campaign-adaptive-3mm-fitted.toml");
+    assert!(
+        fitted_adaptive3.contains("25 runs (25 locations: 10 train, 15 test)"),
+        "{fitted_adaptive3}"
+    );
+    assert_eq!(profile_points(&fitted_adaptive3, 'S'), s3[..10]);
+    assert_eq!(
+        profile_points(&fitted_adaptive3, 'T'),
+        profile_points(sobol3, 'T')
+    );
+    // the fitted skin's mesh, not the voxel skin's: the header's hexahedra
+    let hexes = |t: &str| {
+        t.lines()
+            .next()
+            .and_then(|l| l.split(" hexahedra").next()?.rsplit(' ').next())
+            .map(String::from)
+    };
+    assert_eq!(hexes(&fitted_adaptive3), hexes(&fitted3));
+    assert_ne!(hexes(&fitted3), hexes(&sobol3));
+}
+
 #[test]
 fn tiny_sample_interval_refused() {
     let tmp = tempfile::tempdir().unwrap();

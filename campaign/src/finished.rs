@@ -22,7 +22,7 @@ pub struct FinishedPrefix {
     pub planned_training_locations: usize,
     /// The first unfinished training run, where the prefix stops (`None` when all finished).
     pub stopped_at: Option<String>,
-    /// Finished training runs after it, not read.
+    /// Finished training runs not read (of the stopping location and the ones after it).
     pub finished_after: usize,
 }
 
@@ -71,17 +71,24 @@ pub fn finished_prefix(
     Ok((labels, kept.len(), stop.map(|(l, _)| l.to_string()), after))
 }
 
+/// Refuse the directory `out` of shard `shard` (`Some((i, n))`) where a whole campaign's
+/// dataset is wanted: the other shards' runs are elsewhere.
+pub fn not_a_shard(out: &Path, shard: Option<(usize, usize)>) -> Result<(), String> {
+    match shard {
+        Some((i, n)) => Err(format!(
+            "{}: holds shard {i}/{n} of a campaign; join the shards with `palpa campaign merge` and give the merged directory",
+            out.display()
+        )),
+        None => Ok(()),
+    }
+}
+
 /// Assemble the dataset of `out`'s finished runs ([`finished_prefix`]). An error names the
 /// held-out runs not finished, or refuses a shard's directory (the other shards' runs are
 /// elsewhere: merge them first).
 pub fn assemble_finished(out: &Path) -> Result<FinishedPrefix, String> {
     let cd = read_campaign_dir(out)?;
-    if let Some((i, n)) = cd.shard {
-        return Err(format!(
-            "{}: holds shard {i}/{n} of a campaign; join the shards with `palpa campaign merge` and give the merged directory",
-            out.display()
-        ));
-    }
+    not_a_shard(out, cd.shard)?;
     let plan = cd.plan()?;
     let split: HashMap<&str, Split> = plan
         .locations

@@ -6,7 +6,7 @@
 use crate::assemble::{assemble, write_dataset};
 use crate::dir::{campaign_file, first_difference, read_campaign_dir, CampaignDir};
 use crate::json_file::{read_json, write_json};
-use crate::run_files::{read_done, run_dir};
+use crate::run_files::{is_finished, run_dir};
 use crate::{CAMPAIGN_FILE, DONE_FILE};
 use serde_json::Value;
 use solver::output::atomic::write_atomic;
@@ -83,10 +83,10 @@ pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<MergeReport, String> {
     let mut copied = 0;
     for (k, l) in labels.iter().enumerate() {
         let dst = run_dir(out, l);
-        if read_done(&dst).is_some() {
+        if is_finished(out, l) {
             continue;
         }
-        match dirs.iter().find(|d| read_done(&run_dir(d, l)).is_some()) {
+        match dirs.iter().find(|d| is_finished(d, l)) {
             Some(d) if !same(d, out) => {
                 copy_run(&run_dir(d, l), &dst)?;
                 copied += 1;

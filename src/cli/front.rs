@@ -105,17 +105,17 @@ pub fn run(a: &FrontArgs) -> Result<(), String> {
         if !running {
             check_dataset_path(&dir)?;
         }
-        let data = read_design(&name, &dir, running)?;
-        designs.push((name, dir, runs, data, running));
+        let (data, partial) = read_design(&name, &dir, running)?;
+        designs.push((name, dir, runs, data, partial));
     }
     std::fs::create_dir_all(&a.out)
         .map_err(|e| format!("{}: cannot create: {e}", a.out.display()))?;
     let mut rows = Vec::new();
-    for (name, dir, runs, data, running) in &designs {
+    for (name, dir, runs, data, partial) in &designs {
         let order = data.training_location_order();
         for &n in runs {
             if n > order.len() {
-                let why = if *running {
+                let why = if *partial {
                     format!(
                         "only the first {} training locations are finished",
                         order.len()
@@ -147,14 +147,7 @@ pub fn run(a: &FrontArgs) -> Result<(), String> {
         }
     }
     if rows.is_empty() {
-        return Err(format!(
-            "no point of the front: every --runs count ({}) exceeds the designs' training locations",
-            a.runs
-                .iter()
-                .map(|n| n.to_string())
-                .collect::<Vec<_>>()
-                .join(", ")
-        ));
+        return Err("no point of the front: every run count exceeds its design's training locations (the skipped counts are listed above)".to_string());
     }
     write_outputs(&a.out, &rows)
 }
@@ -165,24 +158,22 @@ fn running_campaign(dir: &Path) -> bool {
 }
 
 /// A design's dataset: its `dataset.npz`, or, for a campaign still running, the dataset of its
-/// finished runs ([`campaign::assemble_finished`]), said on stderr. A shard's directory is
-/// refused: its dataset lacks the other shards' runs.
-fn read_design(name: &str, dir: &Path, running: bool) -> Result<Dataset, String> {
+/// finished runs ([`campaign::assemble_finished`]), said on stderr, and whether that stops
+/// short of the plan's training locations. A shard's directory is refused: its dataset lacks
+/// the other shards' runs.
+fn read_design(name: &str, dir: &Path, running: bool) -> Result<(Dataset, bool), String> {
     if !running {
         if dir.join(campaign::CAMPAIGN_FILE).is_file() {
-            if let Some((i, n)) = campaign::read_campaign_dir(dir)?.shard {
-                return Err(format!(
-                    "{name}: {} holds shard {i}/{n} of a campaign; join the shards with `palpa campaign merge` and give the merged directory",
-                    dir.display()
-                ));
-            }
+            let shard = campaign::read_campaign_dir(dir)?.shard;
+            campaign::not_a_shard(dir, shard).map_err(|e| format!("{name}: {e}"))?;
         }
-        return Dataset::read(dir).map_err(|e| format!("dataset {}: {e}", dir.display()));
+        let data = Dataset::read(dir).map_err(|e| format!("dataset {}: {e}", dir.display()))?;
+        return Ok((data, false));
     }
     let f = campaign::assemble_finished(dir).map_err(|e| format!("{name}: {e}"))?;
     let cut = match &f.stopped_at {
         Some(run) => format!(
-            "; it stops at {run}, not finished ({} later finished training run(s) not used)",
+            "; it stops at {run}, not finished ({} finished training run(s) not read)",
             f.finished_after
         ),
         None => String::new(),
@@ -193,7 +184,7 @@ fn read_design(name: &str, dir: &Path, running: bool) -> Result<Dataset, String>
         f.training_locations,
         f.planned_training_locations
     );
-    Ok(f.dataset)
+    Ok((f.dataset, f.stopped_at.is_some()))
 }
 
 /// `NAME=DIR` or `NAME=DIR:N,N` (the design's own run counts; a DIR ending in `:digits` is
