@@ -420,18 +420,17 @@ fn shipped_profiles_resolve_and_bad_keys_are_named() {
     assert!(sx.iter().all(|y| (165.0..=225.0).contains(y)), "{sx:?}");
     // the 3 mm front's profile: the same sequence, 200 points, its first 100 the 5 mm front's,
     // and the same held-out points
-    let xy = profile_points;
     let sobol3 = dry_run("campaign-sobol-3mm.toml");
     assert!(
         sobol3.contains("215 runs (215 locations: 200 train, 15 test)")
             && sobol3.contains("voxel 3.0 mm"),
         "{sobol3}"
     );
-    let (s5, s3) = (xy(&sobol, 'S'), xy(&sobol3, 'S'));
+    let (s5, s3) = (profile_points(&sobol, 'S'), profile_points(&sobol3, 'S'));
     assert_eq!((s5.len(), s3.len()), (100, 200), "{sobol3}");
     assert_eq!(s3[..100], s5[..]);
-    assert_eq!(xy(&sobol3, 'T'), xy(&sobol, 'T'));
-    assert_eq!(xy(&sobol3, 'T').len(), 12);
+    assert_eq!(profile_points(&sobol3, 'T'), profile_points(&sobol, 'T'));
+    assert_eq!(profile_points(&sobol3, 'T').len(), 12);
     // the raster and the adaptive start of the 3 mm front share those held-out points, and the
     // adaptive start is the Sobol design's first 10
     let grid3 = dry_run("campaign-grid-3mm-fast.toml");
@@ -446,9 +445,9 @@ fn shipped_profiles_resolve_and_bad_keys_are_named() {
     );
     for table in [&grid3, &adaptive3] {
         assert!(table.contains("voxel 3.0 mm"), "{table}");
-        assert_eq!(xy(table, 'T'), xy(&sobol3, 'T'));
+        assert_eq!(profile_points(table, 'T'), profile_points(&sobol3, 'T'));
     }
-    assert_eq!(xy(&adaptive3, 'S'), s3[..10]);
+    assert_eq!(profile_points(&adaptive3, 'S'), s3[..10]);
     fitted_profiles_match_the_3mm_front(&dry_run, &sobol3, &s3);
     // the respiratory design: Sobol over (x, y, phase), whose (x, y) are the plain design's
     let breath = dry_run("campaign-respiration-5mm.toml");
@@ -457,7 +456,7 @@ fn shipped_profiles_resolve_and_bad_keys_are_named() {
             && breath.contains(" phase "),
         "{breath}"
     );
-    assert_eq!(xy(&breath, 'S')[..100], s5[..]);
+    assert_eq!(profile_points(&breath, 'S')[..100], s5[..]);
     fails_naming("[indentation]\ndepht = \"5 mm\"\n", "depht");
     fails_naming(
         "[[locations.design]]\nkind = \"halton\"\nn = 4\nseed = 1\nsplit = \"train\"\n",
@@ -473,8 +472,6 @@ fn shipped_profiles_resolve_and_bad_keys_are_named() {
     assert!(!o.status.success());
 }
 
-/// Issue 29: `sample_interval = "1e-320 s"` was accepted and the campaign never ended; a run
-/// with more samples than the limit is refused, naming the key, unless the limit is raised.
 /// The (x, y) cells of a dry run's rows whose label starts with `prefix`.
 fn profile_points(table: &str, prefix: char) -> Vec<(String, String)> {
     table
@@ -524,6 +521,8 @@ fn fitted_profiles_match_the_3mm_front(
     assert_ne!(hexes(&fitted3), hexes(&sobol3));
 }
 
+/// Issue 29: `sample_interval = "1e-320 s"` was accepted and the campaign never ended; a run
+/// with more samples than the limit is refused, naming the key, unless the limit is raised.
 #[test]
 fn tiny_sample_interval_refused() {
     let tmp = tempfile::tempdir().unwrap();

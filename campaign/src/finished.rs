@@ -12,30 +12,38 @@ use std::collections::HashMap;
 use std::path::Path;
 use surrogate::{Dataset, Split};
 
+/// The runs of a campaign to read while it runs ([`finished_prefix`]).
+#[derive(Debug, PartialEq)]
+pub struct Prefix {
+    /// Labels of the runs to read, in plan order.
+    pub labels: Vec<String>,
+    /// Training locations read: the finished prefix of the plan's training locations.
+    pub training_locations: usize,
+    /// The first unfinished training run, where the prefix stops (`None` when all finished).
+    pub stopped_at: Option<String>,
+    /// Finished training runs not read (of the stopping location and the ones after it).
+    pub unread_finished: usize,
+}
+
 /// What [`assemble_finished`] read.
 pub struct FinishedPrefix {
     /// The dataset of the runs read (not written to the directory).
     pub dataset: Dataset,
-    /// Training locations read: the finished prefix of the plan's training locations.
-    pub training_locations: usize,
+    /// The runs read.
+    pub prefix: Prefix,
     /// Training locations in the plan.
     pub planned_training_locations: usize,
-    /// The first unfinished training run, where the prefix stops (`None` when all finished).
-    pub stopped_at: Option<String>,
-    /// Finished training runs not read (of the stopping location and the ones after it).
-    pub finished_after: usize,
 }
 
 /// The runs to read, given each run's (label, location), each location's split and which runs
 /// are finished: the runs of the training locations (in the order of their first run) before
-/// the first location with an unfinished run, and every held-out run. The prefix's length,
-/// the run it stops at and the finished training runs after it; or the unfinished held-out
-/// runs.
+/// the first location with an unfinished run, and every held-out run; or the unfinished
+/// held-out runs.
 pub fn finished_prefix(
     runs: &[(&str, &str)],
     split: &HashMap<&str, Split>,
     finished: impl Fn(&str) -> bool,
-) -> Result<(Vec<String>, usize, Option<String>, usize), Vec<String>> {
+) -> Result<Prefix, Vec<String>> {
     let is_test = |loc: &str| split.get(loc) == Some(&Split::Test);
     let unfinished_test: Vec<String> = runs
         .iter()
@@ -64,11 +72,16 @@ pub fn finished_prefix(
         .filter(|(_, loc)| is_test(loc) || kept.contains(loc))
         .map(|(l, _)| l.to_string())
         .collect();
-    let after = runs
+    let unread_finished = runs
         .iter()
         .filter(|(l, loc)| !is_test(loc) && !kept.contains(loc) && finished(l))
         .count();
-    Ok((labels, kept.len(), stop.map(|(l, _)| l.to_string()), after))
+    Ok(Prefix {
+        labels,
+        training_locations: kept.len(),
+        stopped_at: stop.map(|(l, _)| l.to_string()),
+        unread_finished,
+    })
 }
 
 /// Refuse the directory `out` of shard `shard` (`Some((i, n))`) where a whole campaign's
@@ -100,7 +113,7 @@ pub fn assemble_finished(out: &Path) -> Result<FinishedPrefix, String> {
         .iter()
         .map(|r| (r.label.as_str(), r.location.as_str()))
         .collect();
-    let (labels, n, stopped_at, finished_after) =
+    let prefix =
         finished_prefix(&runs, &split, |l| is_finished(out, l)).map_err(|missing| {
             format!(
                 "{}: held-out run(s) not finished: {} (a campaign runs its held-out locations last; continue it with --resume)",
@@ -108,13 +121,11 @@ pub fn assemble_finished(out: &Path) -> Result<FinishedPrefix, String> {
                 missing.join(", ")
             )
         })?;
-    let dataset = assemble(&plan, &labels, |l| crate::run_dir(out, l))?;
+    let dataset = assemble(&plan, &prefix.labels, |l| crate::run_dir(out, l))?;
     Ok(FinishedPrefix {
         dataset,
-        training_locations: n,
+        prefix,
         planned_training_locations: split.values().filter(|&&s| s == Split::Train).count(),
-        stopped_at,
-        finished_after,
     })
 }
 
@@ -144,11 +155,26 @@ mod tests {
             ("S3", Split::Train),
             ("A", Split::Test),
         ]);
-        let (labels, n, stop, after) = finished_prefix(&runs, &split, |l| l != "S2-d2").unwrap();
-        assert_eq!(labels, ["S1-d1", "S1-d2", "A-d1"]);
-        assert_eq!((n, stop.as_deref(), after), (1, Some("S2-d2"), 3));
-        let (labels, n, stop, after) = finished_prefix(&runs, &split, |_| true).unwrap();
-        assert_eq!((labels.len(), n, stop, after), (7, 3, None, 0));
+        let p = finished_prefix(&runs, &split, |l| l != "S2-d2").unwrap();
+        assert_eq!(p.labels, ["S1-d1", "S1-d2", "A-d1"]);
+        assert_eq!(
+            (
+                p.training_locations,
+                p.stopped_at.as_deref(),
+                p.unread_finished
+            ),
+            (1, Some("S2-d2"), 3)
+        );
+        let p = finished_prefix(&runs, &split, |_| true).unwrap();
+        assert_eq!(
+            (
+                p.labels.len(),
+                p.training_locations,
+                p.stopped_at,
+                p.unread_finished
+            ),
+            (7, 3, None, 0)
+        );
         let missing = finished_prefix(&runs, &split, |l| l != "A-d1").unwrap_err();
         assert_eq!(missing, ["A-d1"]);
     }

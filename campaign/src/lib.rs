@@ -112,7 +112,7 @@ pub use dir::{
     CampaignDir,
 };
 pub use execute::{execute, run_one, Parallelism, Report, RunEvent};
-pub use finished::{assemble_finished, finished_prefix, not_a_shard, FinishedPrefix};
+pub use finished::{assemble_finished, finished_prefix, not_a_shard, FinishedPrefix, Prefix};
 pub use json_file::{read_json, write_json};
 pub use merge::{merge, MergeReport};
 pub use outcome::{finish, Outcome};

@@ -101,11 +101,7 @@ pub fn run(a: &FrontArgs) -> Result<(), String> {
         if designs.iter().any(|x| x.0 == name) {
             return Err(format!("design `{name}` is named twice"));
         }
-        let running = running_campaign(&dir);
-        if !running {
-            check_dataset_path(&dir)?;
-        }
-        let (data, partial) = read_design(&name, &dir, running)?;
+        let (data, partial) = read_design(&name, &dir)?;
         designs.push((name, dir, runs, data, partial));
     }
     std::fs::create_dir_all(&a.out)
@@ -152,18 +148,17 @@ pub fn run(a: &FrontArgs) -> Result<(), String> {
     write_outputs(&a.out, &rows)
 }
 
-/// Whether `dir` is a campaign still running: its `campaign.json` without a `dataset.npz`.
-fn running_campaign(dir: &Path) -> bool {
-    dir.join(campaign::CAMPAIGN_FILE).is_file() && !dir.join("dataset.npz").is_file()
-}
-
-/// A design's dataset: its `dataset.npz`, or, for a campaign still running, the dataset of its
+/// A design's dataset: its `dataset.npz`, or, for a campaign still running (its `campaign.json`
+/// without a `dataset.npz`), the dataset of its
 /// finished runs ([`campaign::assemble_finished`]), said on stderr, and whether that stops
 /// short of the plan's training locations. A shard's directory is refused: its dataset lacks
 /// the other shards' runs.
-fn read_design(name: &str, dir: &Path, running: bool) -> Result<(Dataset, bool), String> {
+fn read_design(name: &str, dir: &Path) -> Result<(Dataset, bool), String> {
+    let is_campaign = dir.join(campaign::CAMPAIGN_FILE).is_file();
+    let running = is_campaign && !surrogate::dataset::dataset_paths(dir).0.is_file();
     if !running {
-        if dir.join(campaign::CAMPAIGN_FILE).is_file() {
+        check_dataset_path(dir)?;
+        if is_campaign {
             let shard = campaign::read_campaign_dir(dir)?.shard;
             campaign::not_a_shard(dir, shard).map_err(|e| format!("{name}: {e}"))?;
         }
@@ -171,20 +166,22 @@ fn read_design(name: &str, dir: &Path, running: bool) -> Result<(Dataset, bool),
         return Ok((data, false));
     }
     let f = campaign::assemble_finished(dir).map_err(|e| format!("{name}: {e}"))?;
-    let cut = match &f.stopped_at {
+    let p = &f.prefix;
+    let cut = match &p.stopped_at {
         Some(run) => format!(
             "; it stops at {run}, not finished ({} finished training run(s) not read)",
-            f.finished_after
+            p.unread_finished
         ),
         None => String::new(),
     };
     eprintln!(
         "  {name}: {} has no dataset.npz yet: reading its finished runs, the first {} of {} training locations and every held-out one{cut}",
         dir.display(),
-        f.training_locations,
+        p.training_locations,
         f.planned_training_locations
     );
-    Ok((f.dataset, f.stopped_at.is_some()))
+    let partial = p.stopped_at.is_some();
+    Ok((f.dataset, partial))
 }
 
 /// `NAME=DIR` or `NAME=DIR:N,N` (the design's own run counts; a DIR ending in `:digits` is
