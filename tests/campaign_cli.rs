@@ -734,6 +734,43 @@ fn phase_model_takes_the_phase(tmp: &Path, breath: &Path, plain: &Path, d: &Data
     assert!(e.contains("takes x, y and force only"), "{r:?}");
 }
 
+/// `--likelihood-rows N` caps the rows of the GP's hyperparameter search at N (the trained
+/// model says how many it took), and fewer than 2 rows are refused naming the flag.
+fn likelihood_rows_reach_the_gp(tmp: &Path, campaign: &Path) {
+    let model = tmp.join("gp-rows");
+    let train = |rows: &str| {
+        palpa(&[
+            "train",
+            s(campaign),
+            "--model",
+            "gp",
+            "--likelihood-rows",
+            rows,
+            "--out",
+            s(&model),
+        ])
+    };
+    let o = train("3");
+    let text = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        o.status.success() && text.contains("(3 in the likelihood)"),
+        "{text}{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    for bad in [
+        train("1"),
+        palpa(&["front", "d=x", "--likelihood-rows", "0", "--out", s(&model)]),
+    ] {
+        let err = String::from_utf8_lossy(&bad.stderr);
+        assert!(
+            !bad.status.success()
+                && err.contains("--likelihood-rows")
+                && err.contains("at least 2"),
+            "{err}"
+        );
+    }
+}
+
 /// `palpa front` on a campaign still running (no dataset.npz) reads its finished runs: the
 /// training locations before the first unfinished one, and every held-out one; its row at
 /// that count equals the finished campaign's. An unfinished held-out run is named.
@@ -743,6 +780,7 @@ fn front_reads_the_finished_runs_of_a_running_campaign() {
     let file = tiny(tmp.path());
     let out = tmp.path().join("c");
     ok(&["campaign", s(&file), "--out", s(&out), "--quiet"]);
+    likelihood_rows_reach_the_gp(tmp.path(), &out);
     let front = |name: &str| {
         let dir = tmp.path().join(name);
         let o = palpa(&[

@@ -91,6 +91,12 @@ impl Row {
 /// Run `palpa front`.
 pub fn run(a: &FrontArgs) -> Result<(), String> {
     let (interval, recovery_width) = (a.target.interval()?, a.target.recovery_width()?);
+    let mut options = TrainOptions::default();
+    a.target.set_likelihood_rows(&mut options.gp)?;
+    println!(
+        "  GP hyperparameters by the marginal likelihood of at most {} training rows",
+        options.gp.max_likelihood_rows
+    );
     if a.runs.contains(&0) {
         return Err("--runs: counts must be at least 1".into());
     }
@@ -128,7 +134,7 @@ pub fn run(a: &FrontArgs) -> Result<(), String> {
                 recovery_width,
                 ignore_phase: a.target.ignore_phase,
             };
-            let row = point(name, dir, data, &order[..n], &selection)?;
+            let row = point(name, dir, data, &order[..n], &selection, &options)?;
             println!(
                 "  {name:<10} {n:>4} runs, {:.3} core-h: held-out Fit {:.4} (A, B, C {}, others {}), at the paper's stamps {:.4}, 95 % coverage {}, trained in {:.1} s",
                 row.core_hours,
@@ -223,6 +229,7 @@ fn point(
     data: &Dataset,
     locs: &[i64],
     selection: &surrogate::TrainingSelection,
+    options: &TrainOptions,
 ) -> Result<Row, String> {
     let sel = selection
         .apply(data)
@@ -233,9 +240,8 @@ fn point(
             dir.display()
         ));
     }
-    let (_, report, yhat) =
-        surrogate::train_and_predict(&sel, ModelKind::Gp, &TrainOptions::default())
-            .map_err(|e| format!("{name}: {e}"))?;
+    let (_, report, yhat) = surrogate::train_and_predict(&sel, ModelKind::Gp, options)
+        .map_err(|e| format!("{name}: {e}"))?;
     let (abc, other): (Vec<usize>, Vec<usize>) = sel
         .rows_with_split(Split::Test)
         .into_iter()

@@ -1,5 +1,6 @@
 //! The options of `palpa train` and `palpa front` that choose which samples a model learns
-//! from and which target: `--train-interval` and `--recover`.
+//! from and which target (`--train-interval`, `--recover`, `--ignore-phase`), and how many rows
+//! the GP's hyperparameter search takes (`--likelihood-rows`).
 
 use super::units;
 
@@ -20,6 +21,12 @@ pub struct SampleTargetArgs {
     /// phase buys, on the same runs; the held-out samples are scored either way).
     #[arg(long)]
     pub ignore_phase: bool,
+    /// GP: the most training rows the marginal likelihood of the hyperparameter search takes,
+    /// an evenly strided subset of the distinct rows beyond it (the posterior conditions on
+    /// every row either way; surrogate/src/gp/train.rs) [default: 600]. More rows cost
+    /// O(N^3) a likelihood evaluation.
+    #[arg(long, value_name = "N")]
+    pub likelihood_rows: Option<usize>,
 }
 
 impl SampleTargetArgs {
@@ -29,6 +36,20 @@ impl SampleTargetArgs {
             .as_deref()
             .map(|v| units::time(v, "--train-interval"))
             .transpose()
+    }
+
+    /// `--likelihood-rows` set into `gp`, checked.
+    pub fn set_likelihood_rows(&self, gp: &mut surrogate::gp::GpOptions) -> Result<(), String> {
+        match self.likelihood_rows {
+            Some(n) if n < 2 => Err(format!(
+                "--likelihood-rows {n}: give at least 2 rows, e.g. 600 (the default)"
+            )),
+            Some(n) => {
+                gp.max_likelihood_rows = n;
+                Ok(())
+            }
+            None => Ok(()),
+        }
     }
 
     /// `--recover` in m.

@@ -171,6 +171,7 @@ fn options(a: &TrainArgs) -> Result<TrainOptions, String> {
         }
         opts.gp.output_tolerance = t;
     }
+    a.sample_target.set_likelihood_rows(&mut opts.gp)?;
     opts.target = a.target.map(Target::from);
     Ok(opts)
 }
