@@ -771,6 +771,46 @@ fn likelihood_rows_reach_the_gp(tmp: &Path, campaign: &Path) {
     }
 }
 
+/// `--with FRONT.csv` puts an earlier front's rows, as written, before the new design's; a new
+/// design may not take one of its names.
+fn earlier_front_joins_a_new_one(tmp: &Path, campaign: &Path) {
+    let earlier = tmp.join("whole/front.csv");
+    let joined = tmp.join("joined");
+    let front = |name: &str| {
+        palpa(&[
+            "front",
+            &format!("{name}={}", s(campaign)),
+            "--runs",
+            "1",
+            "--with",
+            s(&earlier),
+            "--out",
+            s(&joined),
+        ])
+    };
+    let o = front("again");
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let old: Vec<String> = std::fs::read_to_string(&earlier)
+        .unwrap()
+        .lines()
+        .map(String::from)
+        .collect();
+    let new: Vec<String> = std::fs::read_to_string(joined.join("front.csv"))
+        .unwrap()
+        .lines()
+        .map(String::from)
+        .collect();
+    assert_eq!(new.len(), old.len() + 1, "{new:?}");
+    assert_eq!(new[..old.len()], old[..]);
+    assert!(new[old.len()].starts_with("again,1,"), "{new:?}");
+    let o = front("d");
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        !o.status.success() && err.contains("design `d` is also a design of a --with front"),
+        "{err}"
+    );
+}
+
 /// `palpa front` on a campaign still running (no dataset.npz) reads its finished runs: the
 /// training locations before the first unfinished one, and every held-out one; its row at
 /// that count equals the finished campaign's. An unfinished held-out run is named.
@@ -803,6 +843,7 @@ fn front_reads_the_finished_runs_of_a_running_campaign() {
     let (o, whole) = front("whole");
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     assert_eq!(whole.len(), 2, "{whole:?}");
+    earlier_front_joins_a_new_one(tmp.path(), &out);
     // the campaign stopped with P12, its second training location, unfinished
     for f in [
         "dataset.npz",

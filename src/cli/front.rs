@@ -13,9 +13,11 @@
 //! time times their threads, from each run's `done.json`, in core-hours) and the training
 //! time. A campaign still running (no `dataset.npz` yet) is read from its finished runs
 //! ([`campaign::assemble_finished`]). `--recover H` trains and scores on the recovered stress target
-//! ([`surrogate::recovery`]) instead of the element stress. Written as `front.csv`, `front.md` and `front.png` (Fit against runs, one line per
-//! design), each atomically.
+//! ([`surrogate::recovery`]) instead of the element stress. `--with FRONT.csv` adds an earlier
+//! front's rows ([`super::front_row`]) to the table and the plot. Written as `front.csv`,
+//! `front.md` and `front.png` (Fit against runs, one line per design), each atomically.
 
+use super::front_row::{Row, CSV_HEADER};
 use super::train::check_dataset_path;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
@@ -37,55 +39,14 @@ pub struct FrontArgs {
     pub runs: Vec<usize>,
     #[command(flatten)]
     pub target: super::selection::SampleTargetArgs,
+    /// An earlier front's `front.csv` whose rows join the table and the plot, before the new
+    /// designs' (a front measured in another sitting, drawn beside new designs without
+    /// re-running its campaigns); repeatable. Its design names must differ from the new ones.
+    #[arg(long, value_name = "FRONT.csv")]
+    pub with: Vec<PathBuf>,
     /// Where to write front.csv, front.md and front.png.
     #[arg(long)]
     pub out: PathBuf,
-}
-
-/// One point of the front.
-struct Row {
-    design: String,
-    runs: usize,
-    core_hours: f64,
-    fit_all: f64,
-    fit_abc: Option<f64>,
-    fit_other: Option<f64>,
-    fit_paper_times: f64,
-    coverage: Option<f64>,
-    train_seconds: f64,
-}
-
-impl Row {
-    /// The row's cells as `front.csv` (`md` false) or `front.md` (coverage in %, fewer digits)
-    /// writes them.
-    fn cells(&self, md: bool) -> [String; 9] {
-        let o = |v: Option<f64>| v.map_or(String::new(), |f| format!("{f:.4}"));
-        let coverage = if md {
-            self.coverage
-                .map_or("-".into(), |c| format!("{:.1} %", 100.0 * c))
-        } else {
-            o(self.coverage)
-        };
-        [
-            self.design.clone(),
-            self.runs.to_string(),
-            if md {
-                format!("{:.3}", self.core_hours)
-            } else {
-                format!("{:.4}", self.core_hours)
-            },
-            format!("{:.4}", self.fit_all),
-            o(self.fit_abc),
-            o(self.fit_other),
-            format!("{:.4}", self.fit_paper_times),
-            coverage,
-            if md {
-                format!("{:.1}", self.train_seconds)
-            } else {
-                format!("{:.2}", self.train_seconds)
-            },
-        ]
-    }
 }
 
 /// Run `palpa front`.
@@ -100,6 +61,11 @@ pub fn run(a: &FrontArgs) -> Result<(), String> {
     if a.runs.contains(&0) {
         return Err("--runs: counts must be at least 1".into());
     }
+    let mut rows = Vec::new();
+    for path in &a.with {
+        rows.extend(Row::read_csv(path)?);
+    }
+    let earlier = rows.len();
     // every design read before any is trained, so that a bad one stops the front at once
     let mut designs: Vec<(String, PathBuf, Vec<usize>, Dataset, bool)> = Vec::new();
     for d in &a.designs {
@@ -107,12 +73,16 @@ pub fn run(a: &FrontArgs) -> Result<(), String> {
         if designs.iter().any(|x| x.0 == name) {
             return Err(format!("design `{name}` is named twice"));
         }
+        if rows.iter().any(|r: &Row| r.design == name) {
+            return Err(format!(
+                "design `{name}` is also a design of a --with front: give it another name"
+            ));
+        }
         let (data, partial) = read_design(&name, &dir)?;
         designs.push((name, dir, runs, data, partial));
     }
     std::fs::create_dir_all(&a.out)
         .map_err(|e| format!("{}: cannot create: {e}", a.out.display()))?;
-    let mut rows = Vec::new();
     for (name, dir, runs, data, partial) in &designs {
         let order = data.training_location_order();
         for &n in runs {
@@ -148,7 +118,7 @@ pub fn run(a: &FrontArgs) -> Result<(), String> {
             rows.push(row);
         }
     }
-    if rows.is_empty() {
+    if rows.len() == earlier {
         return Err("no point of the front: every run count exceeds its design's training locations (the skipped counts are listed above)".to_string());
     }
     write_outputs(&a.out, &rows)
@@ -291,9 +261,7 @@ fn training_seconds(dir: &Path, data: &Dataset, locs: &[i64]) -> Result<f64, Str
 }
 
 fn write_outputs(out: &Path, rows: &[Row]) -> Result<(), String> {
-    let mut csv = String::from(
-        "design,runs,core_hours,fit_heldout,fit_abc,fit_other,fit_paper_times,coverage_95,train_seconds\n",
-    );
+    let mut csv = format!("{CSV_HEADER}\n");
     let mut md = String::from(
         "| design | runs | solver core-h | held-out Fit | A, B, C | other held-out | at the paper's stamps | 95 % coverage | GP training (s) |\n|---|---:|---:|---:|---:|---:|---:|---:|---:|\n",
     );

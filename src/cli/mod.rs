@@ -7,6 +7,7 @@ mod check;
 mod evaluate;
 mod export;
 mod front;
+mod front_row;
 mod input;
 mod material;
 mod mesh;

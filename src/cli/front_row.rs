@@ -1,0 +1,150 @@
+//! One point of `palpa front`: its cells as `front.csv` and `front.md` write them, and a row
+//! read back from an earlier `front.csv` (`--with`), so that a front measured in another sitting
+//! is drawn beside new designs without its campaigns.
+
+use std::path::Path;
+
+/// `front.csv`'s header; `--with` reads files that start with it.
+pub const CSV_HEADER: &str =
+    "design,runs,core_hours,fit_heldout,fit_abc,fit_other,fit_paper_times,coverage_95,train_seconds";
+
+/// One point of the front.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Row {
+    pub design: String,
+    pub runs: usize,
+    pub core_hours: f64,
+    pub fit_all: f64,
+    pub fit_abc: Option<f64>,
+    pub fit_other: Option<f64>,
+    pub fit_paper_times: f64,
+    pub coverage: Option<f64>,
+    pub train_seconds: f64,
+}
+
+impl Row {
+    /// The row's cells as `front.csv` (`md` false) or `front.md` (coverage in %, fewer digits)
+    /// writes them.
+    pub fn cells(&self, md: bool) -> [String; 9] {
+        let o = |v: Option<f64>| v.map_or(String::new(), |f| format!("{f:.4}"));
+        let coverage = if md {
+            self.coverage
+                .map_or("-".into(), |c| format!("{:.1} %", 100.0 * c))
+        } else {
+            o(self.coverage)
+        };
+        [
+            self.design.clone(),
+            self.runs.to_string(),
+            if md {
+                format!("{:.3}", self.core_hours)
+            } else {
+                format!("{:.4}", self.core_hours)
+            },
+            format!("{:.4}", self.fit_all),
+            o(self.fit_abc),
+            o(self.fit_other),
+            format!("{:.4}", self.fit_paper_times),
+            coverage,
+            if md {
+                format!("{:.1}", self.train_seconds)
+            } else {
+                format!("{:.2}", self.train_seconds)
+            },
+        ]
+    }
+
+    /// The rows of an earlier `front.csv` at `path`; a bad file is named with its line and
+    /// column.
+    pub fn read_csv(path: &Path) -> Result<Vec<Row>, String> {
+        let text = std::fs::read_to_string(path)
+            .map_err(|e| format!("--with {}: cannot read: {e}", path.display()))?;
+        let mut lines = text.lines().enumerate();
+        match lines.next() {
+            Some((_, h)) if h.trim() == CSV_HEADER => {}
+            _ => {
+                return Err(format!(
+                    "--with {}:1: not a front.csv (its header must be `{CSV_HEADER}`)",
+                    path.display()
+                ))
+            }
+        }
+        lines
+            .filter(|(_, l)| !l.trim().is_empty())
+            .map(|(i, l)| {
+                Row::parse(l).map_err(|e| format!("--with {}:{}: {e}", path.display(), i + 1))
+            })
+            .collect()
+    }
+
+    /// One data line of `front.csv`.
+    fn parse(line: &str) -> Result<Row, String> {
+        let cells: Vec<&str> = line.split(',').map(str::trim).collect();
+        if cells.len() != 9 {
+            return Err(format!("{} cells, the header has 9", cells.len()));
+        }
+        let names: Vec<&str> = CSV_HEADER.split(',').collect();
+        let num = |k: usize| {
+            cells[k]
+                .parse::<f64>()
+                .ok()
+                .filter(|v| v.is_finite())
+                .ok_or_else(|| format!("{}: `{}` is not a number", names[k], cells[k]))
+        };
+        let maybe = |k: usize| (!cells[k].is_empty()).then(|| num(k)).transpose();
+        if cells[0].is_empty() {
+            return Err("design: empty".into());
+        }
+        Ok(Row {
+            design: cells[0].to_string(),
+            runs: cells[1]
+                .parse()
+                .map_err(|_| format!("runs: `{}` is not a count", cells[1]))?,
+            core_hours: num(2)?,
+            fit_all: num(3)?,
+            fit_abc: maybe(4)?,
+            fit_other: maybe(5)?,
+            fit_paper_times: num(6)?,
+            coverage: maybe(7)?,
+            train_seconds: num(8)?,
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{Row, CSV_HEADER};
+
+    #[test]
+    fn a_written_row_reads_back_and_bad_cells_are_named() {
+        let row = Row {
+            design: "sobol".into(),
+            runs: 25,
+            core_hours: 1.0597,
+            fit_all: 0.9433,
+            fit_abc: Some(0.9452),
+            fit_other: None,
+            fit_paper_times: 0.9358,
+            coverage: Some(0.9101),
+            train_seconds: 50.16,
+        };
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("front.csv");
+        let line = row.cells(false).join(",");
+        std::fs::write(&path, format!("{CSV_HEADER}\n{line}\n")).unwrap();
+        assert_eq!(Row::read_csv(&path).unwrap(), vec![row]);
+        std::fs::write(
+            &path,
+            format!("{CSV_HEADER}\n{}\n", line.replace("0.9433", "x")),
+        )
+        .unwrap();
+        let err = Row::read_csv(&path).unwrap_err();
+        assert!(
+            err.contains("front.csv:2: fit_heldout: `x` is not a number"),
+            "{err}"
+        );
+        std::fs::write(&path, "runs,fit\n1,2\n").unwrap();
+        let err = Row::read_csv(&path).unwrap_err();
+        assert!(err.contains("front.csv:1: not a front.csv"), "{err}");
+    }
+}
