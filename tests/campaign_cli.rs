@@ -809,6 +809,21 @@ fn earlier_front_joins_a_new_one(tmp: &Path, campaign: &Path) {
         !o.status.success() && err.contains("design `d` is also a design of a --with front"),
         "{err}"
     );
+    let o = palpa(&[
+        "front",
+        "e=x",
+        "--with",
+        s(&earlier),
+        "--with",
+        s(&earlier),
+        "--out",
+        s(&joined),
+    ]);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        !o.status.success() && err.contains("design `d` is also in an earlier --with front"),
+        "{err}"
+    );
 }
 
 /// `palpa front` on a campaign still running (no dataset.npz) reads its finished runs: the

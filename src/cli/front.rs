@@ -54,16 +54,23 @@ pub fn run(a: &FrontArgs) -> Result<(), String> {
     let (interval, recovery_width) = (a.target.interval()?, a.target.recovery_width()?);
     let mut options = TrainOptions::default();
     a.target.set_likelihood_rows(&mut options.gp)?;
-    println!(
-        "  GP hyperparameters by the marginal likelihood of at most {} training rows",
-        options.gp.max_likelihood_rows
-    );
     if a.runs.contains(&0) {
         return Err("--runs: counts must be at least 1".into());
     }
     let mut rows = Vec::new();
     for path in &a.with {
-        rows.extend(Row::read_csv(path)?);
+        let more = Row::read_csv(path)?;
+        if let Some(r) = more
+            .iter()
+            .find(|r| rows.iter().any(|o: &Row| o.design == r.design))
+        {
+            return Err(format!(
+                "--with {}: design `{}` is also in an earlier --with front",
+                path.display(),
+                r.design
+            ));
+        }
+        rows.extend(more);
     }
     let earlier = rows.len();
     // every design read before any is trained, so that a bad one stops the front at once
@@ -83,6 +90,10 @@ pub fn run(a: &FrontArgs) -> Result<(), String> {
     }
     std::fs::create_dir_all(&a.out)
         .map_err(|e| format!("{}: cannot create: {e}", a.out.display()))?;
+    println!(
+        "  GP hyperparameters by the marginal likelihood of at most {} training rows",
+        options.gp.max_likelihood_rows
+    );
     for (name, dir, runs, data, partial) in &designs {
         let order = data.training_location_order();
         for &n in runs {
