@@ -771,8 +771,8 @@ fn likelihood_rows_reach_the_gp(tmp: &Path, campaign: &Path) {
     }
 }
 
-/// `--with FRONT.csv` puts an earlier front's rows, as written, before the new design's; a new
-/// design may not take one of its names.
+/// `--with FRONT.csv` puts an earlier front's rows, as written, before the new design's; a point
+/// (design, runs) may not be given twice, by a new design or by two fronts.
 fn earlier_front_joins_a_new_one(tmp: &Path, campaign: &Path) {
     let earlier = tmp.join("whole/front.csv");
     let joined = tmp.join("joined");
@@ -806,7 +806,8 @@ fn earlier_front_joins_a_new_one(tmp: &Path, campaign: &Path) {
     let o = front("d");
     let err = String::from_utf8_lossy(&o.stderr);
     assert!(
-        !o.status.success() && err.contains("design `d` is also a design of a --with front"),
+        !o.status.success()
+            && err.contains("design `d` at 1 runs is already a point of a --with front"),
         "{err}"
     );
     let o = palpa(&[
@@ -821,7 +822,7 @@ fn earlier_front_joins_a_new_one(tmp: &Path, campaign: &Path) {
     ]);
     let err = String::from_utf8_lossy(&o.stderr);
     assert!(
-        !o.status.success() && err.contains("design `d` is also in an earlier --with front"),
+        !o.status.success() && err.contains("design `d` at 1 runs is given twice"),
         "{err}"
     );
 }

@@ -41,7 +41,8 @@ pub struct FrontArgs {
     pub target: super::selection::SampleTargetArgs,
     /// An earlier front's `front.csv` whose rows join the table and the plot, before the new
     /// designs' (a front measured in another sitting, drawn beside new designs without
-    /// re-running its campaigns); repeatable. Its design names must differ from the new ones.
+    /// re-running its campaigns, or a design's front extended to more runs); repeatable. A
+    /// point (design and run count) may not be given twice.
     #[arg(long, value_name = "FRONT.csv")]
     pub with: Vec<PathBuf>,
     /// Where to write front.csv, front.md and front.png.
@@ -57,21 +58,7 @@ pub fn run(a: &FrontArgs) -> Result<(), String> {
     if a.runs.contains(&0) {
         return Err("--runs: counts must be at least 1".into());
     }
-    let mut rows = Vec::new();
-    for path in &a.with {
-        let more = Row::read_csv(path)?;
-        if let Some(r) = more
-            .iter()
-            .find(|r| rows.iter().any(|o: &Row| o.design == r.design))
-        {
-            return Err(format!(
-                "--with {}: design `{}` is also in an earlier --with front",
-                path.display(),
-                r.design
-            ));
-        }
-        rows.extend(more);
-    }
+    let mut rows = Row::read_fronts(&a.with)?;
     let earlier = rows.len();
     // every design read before any is trained, so that a bad one stops the front at once
     let mut designs: Vec<(String, PathBuf, Vec<usize>, Dataset, bool)> = Vec::new();
@@ -80,9 +67,13 @@ pub fn run(a: &FrontArgs) -> Result<(), String> {
         if designs.iter().any(|x| x.0 == name) {
             return Err(format!("design `{name}` is named twice"));
         }
-        if rows.iter().any(|r: &Row| r.design == name) {
+        if let Some(r) = rows
+            .iter()
+            .find(|r| r.design == name && runs.contains(&r.runs))
+        {
             return Err(format!(
-                "design `{name}` is also a design of a --with front: give it another name"
+                "design `{name}` at {} runs is already a point of a --with front: leave that count out or give the design another name",
+                r.runs
             ));
         }
         let (data, partial) = read_design(&name, &dir)?;
@@ -291,6 +282,10 @@ fn write_outputs(out: &Path, rows: &[Row]) -> Result<(), String> {
             Some(c) => c.1.push((r.runs as f64, r.fit_all)),
             None => curves.push((r.design.clone(), vec![(r.runs as f64, r.fit_all)])),
         }
+    }
+    // a design extended with --with has its earlier points first, in their own order
+    for c in &mut curves {
+        c.1.sort_by(|p, q| p.0.total_cmp(&q.0));
     }
     let series = verification::Series {
         plot: "front".into(),

@@ -54,6 +54,28 @@ impl Row {
         ]
     }
 
+    /// The rows of the earlier fronts at `paths` (`--with`), in order; a point (design and run
+    /// count) given twice is refused.
+    pub fn read_fronts(paths: &[std::path::PathBuf]) -> Result<Vec<Row>, String> {
+        let mut rows: Vec<Row> = Vec::new();
+        for path in paths {
+            let more = Row::read_csv(path)?;
+            for (k, r) in more.iter().enumerate() {
+                let twice = |o: &Row| o.design == r.design && o.runs == r.runs;
+                if rows.iter().chain(&more[..k]).any(twice) {
+                    return Err(format!(
+                        "--with {}: design `{}` at {} runs is given twice",
+                        path.display(),
+                        r.design,
+                        r.runs
+                    ));
+                }
+            }
+            rows.extend(more);
+        }
+        Ok(rows)
+    }
+
     /// The rows of an earlier `front.csv` at `path`; a bad file is named with its line and
     /// column.
     pub fn read_csv(path: &Path) -> Result<Vec<Row>, String> {
