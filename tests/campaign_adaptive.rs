@@ -34,6 +34,45 @@ duration = "1 ms"
 sample_interval = "0.5 ms"
 "#;
 
+/// The finished campaign's runs, copied into a new directory without its plan or record: the
+/// same batches are chosen and their copied runs reused (nothing is solved), with no note that
+/// they are not reused, and the dataset is the same, byte for byte.
+fn batch_runs_copied_in_are_reused(file: &Path, straight: &Path, flags: &[&str]) {
+    let copied = straight.with_file_name("copied");
+    let runs = copied.join("runs");
+    std::fs::create_dir_all(&runs).unwrap();
+    for e in std::fs::read_dir(straight.join("runs")).unwrap() {
+        let e = e.unwrap();
+        let to = runs.join(e.file_name());
+        std::fs::create_dir_all(&to).unwrap();
+        for f in std::fs::read_dir(e.path()).unwrap() {
+            let f = f.unwrap();
+            std::fs::copy(f.path(), to.join(f.file_name())).unwrap();
+        }
+    }
+    let mut args = vec!["campaign", s(file), "--out", s(&copied), "--resume"];
+    args.extend(flags);
+    let o = palpa(&args);
+    let (out, err) = (
+        String::from_utf8_lossy(&o.stdout),
+        String::from_utf8_lossy(&o.stderr),
+    );
+    assert!(o.status.success(), "{err}");
+    assert!(
+        out.contains("7 finished, 0 to run") && out.contains("8 finished, 0 to run"),
+        "{out}"
+    );
+    assert!(
+        out.lines()
+            .filter(|l| l.contains(" to run:"))
+            .all(|l| l.contains(" 0 to run:")),
+        "{out}"
+    );
+    assert!(!err.contains("not reused"), "{err}");
+    let bytes = |dir: &Path| std::fs::read(dir.join("dataset.npz")).unwrap();
+    assert_eq!(bytes(&copied), bytes(straight));
+}
+
 #[test]
 fn adaptive_batches_are_recorded_and_resume_to_the_same_bytes() {
     let tmp = tempfile::tempdir().unwrap();
@@ -124,6 +163,7 @@ fn adaptive_batches_are_recorded_and_resume_to_the_same_bytes() {
         "{again}"
     );
     assert_eq!(campaign::AdaptiveRecord::read(&straight).unwrap(), rec);
+    batch_runs_copied_in_are_reused(&file, &straight, &flags);
 
     // the front: the GP on the first 4 and 7 training runs, scored on A; 9 runs are skipped
     let front = tmp.path().join("front");

@@ -102,8 +102,8 @@ mod shard;
 mod spec;
 
 pub use adaptive::{
-    check_adaptive, extend, next_batch, AdaptiveBatch, AdaptivePoint, AdaptiveRecord,
-    ADAPTIVE_FILE, CANDIDATES, CANDIDATE_SEED, FORCE_POINTS,
+    batch_label, check_adaptive, extend, is_batch_label, next_batch, AdaptiveBatch, AdaptivePoint,
+    AdaptiveRecord, ADAPTIVE_FILE, CANDIDATES, CANDIDATE_SEED, FORCE_POINTS, MIN_SEPARATION,
 };
 pub use assemble::{assemble, write_dataset};
 pub use design::{default_extent, DesignKind, DesignSpec, Region, MAX_DESIGN_POINTS};

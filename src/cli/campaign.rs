@@ -160,7 +160,7 @@ fn run_campaign(a: &CampaignArgs) -> Result<(), String> {
     if !a.quiet || a.dry_run {
         print_header(&campaign, &phantom, shard, mine.len(), build_s);
     }
-    print_stray(out, &campaign);
+    print_stray(out, &campaign, a.adaptive.is_some());
     if a.dry_run {
         print_plan(&campaign, &locs, &mine, &done);
         return Ok(());
@@ -346,7 +346,14 @@ fn run_and_grow(
         let locs = campaign.resolve_locations(phantom)?;
         st.plan = campaign.plan(phantom, &locs);
         campaign::write_campaign_file(out, &st.plan, None)?;
-        todo = campaign.runs[first_new..].to_vec();
+        // a batch's runs already finished in --out (copied from a campaign that chose the
+        // same batch) are reused, as the campaign's own runs are on --resume
+        let (reused, new): (Vec<PlannedRun>, Vec<PlannedRun>) = campaign.runs[first_new..]
+            .iter()
+            .cloned()
+            .partition(|r| campaign::is_finished(out, &r.label));
+        st.n_done += reused.len();
+        todo = new;
     }
 }
 
@@ -415,8 +422,10 @@ fn run_todo(
 /// so does not reuse (e.g. runs of a 75-point design copied to extend it to 200 points: S01..
 /// there, S001.. here). The whole campaign's labels, not the shard's: a shard's directory may
 /// hold the other shards' runs.
-fn print_stray(out: &Path, campaign: &campaign::Campaign) {
-    let stray = campaign::stray_runs(out, campaign.runs.iter().map(|r| r.label.as_str()));
+fn print_stray(out: &Path, campaign: &campaign::Campaign, adaptive: bool) {
+    let mut stray = campaign::stray_runs(out, campaign.runs.iter().map(|r| r.label.as_str()));
+    // with --adaptive, a later batch may name them (copied runs of the same batches)
+    stray.retain(|l| !(adaptive && campaign::is_batch_label(l)));
     if stray.is_empty() {
         return;
     }
