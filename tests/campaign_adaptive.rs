@@ -34,13 +34,10 @@ duration = "1 ms"
 sample_interval = "0.5 ms"
 "#;
 
-/// The finished campaign's runs, copied into a new directory without its plan or record: the
-/// same batches are chosen and their copied runs reused (nothing is solved), with no note that
-/// they are not reused, and the dataset is the same, byte for byte.
-fn batch_runs_copied_in_are_reused(file: &Path, straight: &Path, flags: &[&str]) {
-    let copied = straight.with_file_name("copied");
+/// `straight`'s runs copied into `name` beside it, without its plan or record.
+fn copy_runs(straight: &Path, name: &str) -> std::path::PathBuf {
+    let copied = straight.with_file_name(name);
     let runs = copied.join("runs");
-    std::fs::create_dir_all(&runs).unwrap();
     for e in std::fs::read_dir(straight.join("runs")).unwrap() {
         let e = e.unwrap();
         let to = runs.join(e.file_name());
@@ -50,6 +47,15 @@ fn batch_runs_copied_in_are_reused(file: &Path, straight: &Path, flags: &[&str])
             std::fs::copy(f.path(), to.join(f.file_name())).unwrap();
         }
     }
+    copied
+}
+
+/// The finished campaign's runs, copied into a new directory without its plan or record: the
+/// same batches are chosen and their copied runs reused (nothing is solved), with no note that
+/// they are not reused, and the dataset is the same, byte for byte. A copied run that is not
+/// the palpation its batch plans (ad01-01 holding ad01-02's) is refused, naming it.
+fn batch_runs_copied_in_are_reused(file: &Path, straight: &Path, flags: &[&str]) {
+    let copied = copy_runs(straight, "copied");
     let mut args = vec!["campaign", s(file), "--out", s(&copied), "--resume"];
     args.extend(flags);
     let o = palpa(&args);
@@ -71,6 +77,18 @@ fn batch_runs_copied_in_are_reused(file: &Path, straight: &Path, flags: &[&str])
     assert!(!err.contains("not reused"), "{err}");
     let bytes = |dir: &Path| std::fs::read(dir.join("dataset.npz")).unwrap();
     assert_eq!(bytes(&copied), bytes(straight));
+    let wrong = copy_runs(straight, "wrong");
+    let scene = |l: &str| wrong.join("runs").join(l).join("scene.toml");
+    std::fs::copy(scene("ad01-02"), scene("ad01-01")).unwrap();
+    let mut args = vec!["campaign", s(file), "--out", s(&wrong), "--resume"];
+    args.extend(flags);
+    let o = palpa(&args);
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        !o.status.success()
+            && err.contains("ad01-01/scene.toml: a finished run that is not the palpation adaptive batch 1 plans"),
+        "{err}"
+    );
 }
 
 #[test]

@@ -347,11 +347,22 @@ fn run_and_grow(
         st.plan = campaign.plan(phantom, &locs);
         campaign::write_campaign_file(out, &st.plan, None)?;
         // a batch's runs already finished in --out (copied from a campaign that chose the
-        // same batch) are reused, as the campaign's own runs are on --resume
+        // same batch) are reused, as the campaign's own runs are on --resume, when they are
+        // the palpations the batch plans
         let (reused, new): (Vec<PlannedRun>, Vec<PlannedRun>) = campaign.runs[first_new..]
             .iter()
             .cloned()
             .partition(|r| campaign::is_finished(out, &r.label));
+        for r in &reused {
+            let path = campaign::run_dir(out, &r.label).join("scene.toml");
+            if std::fs::read_to_string(&path).ok() != Some(campaign.setup(r).scene_toml()) {
+                return Err(format!(
+                    "{}: a finished run that is not the palpation adaptive batch {number} plans for {} (another location or setting): remove its directory, or start from runs of a campaign that chose the same batches",
+                    path.display(),
+                    r.label
+                ));
+            }
+        }
         st.n_done += reused.len();
         todo = new;
     }
