@@ -173,14 +173,14 @@ pub fn batch_label(batch: usize, k: usize) -> String {
     format!("ad{batch:02}-{k:02}")
 }
 
-/// Whether `label` has the form of an adaptive batch's label (`ad01-01`): a run a later batch
-/// of an adaptive campaign may name.
+/// Whether `label` has the form of an adaptive batch's label (`ad01-01`, `ad100-01`): a run a
+/// later batch of an adaptive campaign may name.
 pub fn is_batch_label(label: &str) -> bool {
-    let b = label.as_bytes();
-    label.len() == 7
-        && label.starts_with("ad")
-        && b[4] == b'-'
-        && [2, 3, 5, 6].iter().all(|&i| b[i].is_ascii_digit())
+    let digits = |s: &str| s.len() >= 2 && s.bytes().all(|c| c.is_ascii_digit());
+    label
+        .strip_prefix("ad")
+        .and_then(|r| r.split_once('-'))
+        .is_some_and(|(b, k)| digits(b) && digits(k))
 }
 
 /// Choose batch number `batch` of `size` locations from `candidates` (m) on the campaign's
@@ -306,7 +306,8 @@ mod tests {
             }
         }
         assert_eq!(b.points[2].label, "ad01-03");
-        assert!(is_batch_label("ad01-03") && !is_batch_label("ad1-03") && !is_batch_label("S001"));
+        assert!(is_batch_label("ad01-03") && is_batch_label(&batch_label(100, 2)));
+        assert!(!is_batch_label("ad1-03") && !is_batch_label("S001") && !is_batch_label("ad01-"));
         assert_eq!(b.trained_on_locations, 21);
         // a candidate that is not over the skin is passed over
         let b2 = next_batch(&data, &cands, 2, 1, &|x, y| !(x > 0.055 && y > 0.055)).unwrap();

@@ -8,7 +8,9 @@
 //! - `runs/<label>/`: one palpation each (`scene.toml`, `probe.csv`, `probe_stress.csv`,
 //!   `history.csv`, `summary.json`), finished when `done.json` exists (written last,
 //!   atomically); `--resume` skips finished runs and redoes any other run directory from
-//!   scratch;
+//!   scratch; with `--adaptive`, a new batch's runs already finished there are reused when
+//!   their `scene.toml` is the palpation the batch plans (copied from a campaign that chose the
+//!   same batches), and solved again otherwise;
 //! - `view.json`: the phantom in plan view (outlines, ROI cells, the hand;
 //!   [`surrogate::ViewGeometry`]), which `palpa train` puts beside the model;
 //! - `dataset.npz` + `manifest.json` (also as `dataset.json`, so that both `palpa train DIR` and
@@ -347,22 +349,24 @@ fn run_and_grow(
         st.plan = campaign.plan(phantom, &locs);
         campaign::write_campaign_file(out, &st.plan, None)?;
         // a batch's runs already finished in --out (copied from a campaign that chose the
-        // same batch) are reused, as the campaign's own runs are on --resume, when they are
-        // the palpations the batch plans
+        // same batch) are reused when their scene is the palpation the batch plans; any other
+        // is solved again
         let (reused, new): (Vec<PlannedRun>, Vec<PlannedRun>) = campaign.runs[first_new..]
             .iter()
             .cloned()
-            .partition(|r| campaign::is_finished(out, &r.label));
-        for r in &reused {
-            let path = campaign::run_dir(out, &r.label).join("scene.toml");
-            if std::fs::read_to_string(&path).ok() != Some(campaign.setup(r).scene_toml()) {
-                return Err(format!(
-                    "{}: a finished run that is not the palpation adaptive batch {number} plans for {} (another location or setting): remove its directory, or start from runs of a campaign that chose the same batches",
-                    path.display(),
-                    r.label
-                ));
-            }
-        }
+            .partition(|r| {
+                let path = campaign::run_dir(out, &r.label).join("scene.toml");
+                let finished = campaign::is_finished(out, &r.label);
+                let same = std::fs::read_to_string(&path).ok() == Some(campaign.setup(r).scene_toml());
+                if finished && !same {
+                    eprintln!(
+                        "note: {} is not the palpation adaptive batch {number} plans for {} (another location, setting or palpa version): it is solved again",
+                        path.display(),
+                        r.label
+                    );
+                }
+                finished && same
+            });
         st.n_done += reused.len();
         todo = new;
     }
@@ -432,7 +436,8 @@ fn run_todo(
 /// Name on stderr, `--quiet` or not, the finished runs in `out` that the plan does not name and
 /// so does not reuse (e.g. runs of a 75-point design copied to extend it to 200 points: S01..
 /// there, S001.. here). The whole campaign's labels, not the shard's: a shard's directory may
-/// hold the other shards' runs.
+/// hold the other shards' runs. With `--adaptive`, runs labelled as batches are left out: a
+/// batch chosen later may name them and reuse them.
 fn print_stray(out: &Path, campaign: &campaign::Campaign, adaptive: bool) {
     let mut stray = campaign::stray_runs(out, campaign.runs.iter().map(|r| r.label.as_str()));
     // with --adaptive, a later batch may name them (copied runs of the same batches)

@@ -169,6 +169,11 @@ fn parse_design(d: &str, runs: &[usize]) -> Result<(String, PathBuf, Vec<usize>)
         .split_once('=')
         .filter(|(n, r)| !n.is_empty() && !r.is_empty())
         .ok_or_else(|| format!("design `{d}`: give NAME=DIR or NAME=DIR:N,N"))?;
+    if name.contains(',') || name.trim() != name {
+        return Err(format!(
+            "design `{name}`: a name without commas or surrounding spaces, as front.csv writes it unquoted"
+        ));
+    }
     let counts = rest
         .rsplit_once(':')
         .filter(|(_, l)| !l.is_empty() && l.chars().all(|c| c.is_ascii_digit() || c == ','));
