@@ -11,14 +11,23 @@ pub const CSV_HEADER: &str =
 /// One point of the front.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Row {
+    /// The design's name (NAME of NAME=DIR).
     pub design: String,
+    /// Training runs (locations) the GP learned from.
     pub runs: usize,
+    /// Those runs' solver cost: wall time times threads (core-hours).
     pub core_hours: f64,
+    /// Held-out Fit (paper eq. 5) over every held-out location.
     pub fit_all: f64,
+    /// Held-out Fit over A, B and C, when the campaign holds them out.
     pub fit_abc: Option<f64>,
+    /// Held-out Fit over the other held-out locations, if any.
     pub fit_other: Option<f64>,
+    /// Held-out Fit at the paper's time stamps.
     pub fit_paper_times: f64,
+    /// Share of held-out values inside the GP's 95 % intervals.
     pub coverage: Option<f64>,
+    /// The GP's training time (s).
     pub train_seconds: f64,
 }
 
