@@ -757,6 +757,21 @@ fn likelihood_rows_reach_the_gp(tmp: &Path, campaign: &Path) {
         "{text}{}",
         String::from_utf8_lossy(&o.stderr)
     );
+    let mlp = palpa(&[
+        "train",
+        s(campaign),
+        "--model",
+        "mlp",
+        "--likelihood-rows",
+        "3",
+        "--out",
+        s(&model),
+    ]);
+    let err = String::from_utf8_lossy(&mlp.stderr);
+    assert!(
+        !mlp.status.success() && err.contains("--likelihood-rows sets the GP's"),
+        "{err}"
+    );
     for bad in [
         train("1"),
         palpa(&["front", "d=x", "--likelihood-rows", "0", "--out", s(&model)]),

@@ -171,6 +171,11 @@ fn options(a: &TrainArgs) -> Result<TrainOptions, String> {
         }
         opts.gp.output_tolerance = t;
     }
+    if a.sample_target.likelihood_rows.is_some() && matches!(a.model, ModelArg::Mlp) {
+        return Err(
+            "--likelihood-rows sets the GP's hyperparameter search: give it with --model gp".into(),
+        );
+    }
     a.sample_target.set_likelihood_rows(&mut opts.gp)?;
     opts.target = a.target.map(Target::from);
     Ok(opts)
