@@ -70,6 +70,13 @@ impl Campaign {
             .collect()
     }
 
+    /// Whether the run directory of `r` in `out` holds the scene this plan gives `r` (its
+    /// `scene.toml`, as [`Campaign::setup`] writes it).
+    pub fn is_run_as_planned(&self, out: &std::path::Path, r: &PlannedRun) -> bool {
+        let path = crate::run_files::run_dir(out, &r.label).join("scene.toml");
+        std::fs::read_to_string(path).ok() == Some(self.setup(r).scene_toml())
+    }
+
     /// The palpation of run `r`.
     pub fn setup(&self, r: &PlannedRun) -> PalpationSetup {
         let loc = &self.locations[r.location];

@@ -355,13 +355,12 @@ fn run_and_grow(
             .iter()
             .cloned()
             .partition(|r| {
-                let path = campaign::run_dir(out, &r.label).join("scene.toml");
                 let finished = campaign::is_finished(out, &r.label);
-                let same = std::fs::read_to_string(&path).ok() == Some(campaign.setup(r).scene_toml());
+                let same = campaign.is_run_as_planned(out, r);
                 if finished && !same {
                     eprintln!(
                         "note: {} is not the palpation adaptive batch {number} plans for {} (another location, setting or palpa version): it is solved again",
-                        path.display(),
+                        campaign::run_dir(out, &r.label).join("scene.toml").display(),
                         r.label
                     );
                 }
