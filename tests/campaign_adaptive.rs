@@ -50,12 +50,20 @@ fn copy_runs(straight: &Path, name: &str) -> std::path::PathBuf {
     copied
 }
 
-/// The finished campaign's runs, copied into a new directory without its plan or record: the
-/// same batches are chosen and their copied runs reused (nothing is solved), with no note that
-/// they are not reused, and the dataset is the same, byte for byte. A copied run that is not
-/// the palpation its batch plans is solved again.
+/// The finished campaign's runs, copied into a new directory without its plan or record and
+/// titled as another campaign's (a Sobol design's runs copied into an adaptive one): the same
+/// batches are chosen and the copied runs reused (nothing is solved), with no note that they
+/// are not reused, and the dataset is the same, byte for byte. A copied run that is not the
+/// palpation its batch, or the initial design, plans is solved again.
 fn batch_runs_copied_in_are_reused(file: &Path, straight: &Path, flags: &[&str]) {
     let copied = copy_runs(straight, "copied");
+    for e in std::fs::read_dir(copied.join("runs")).unwrap() {
+        let path = e.unwrap().path().join("scene.toml");
+        let text = std::fs::read_to_string(&path).unwrap();
+        assert!(text.contains("title = \"tiny adaptive: "), "{text}");
+        let text = text.replace("title = \"tiny adaptive: ", "title = \"tiny Sobol: ");
+        std::fs::write(&path, text).unwrap();
+    }
     let mut args = vec!["campaign", s(file), "--out", s(&copied), "--resume"];
     args.extend(flags);
     let o = palpa(&args);
@@ -74,15 +82,21 @@ fn batch_runs_copied_in_are_reused(file: &Path, straight: &Path, flags: &[&str])
             .all(|l| l.contains(" 0 to run:")),
         "{out}"
     );
-    assert!(!err.contains("not reused"), "{err}");
+    assert!(
+        !err.contains("not reused") && !err.contains("solved again"),
+        "{err}"
+    );
     let bytes = |dir: &Path| std::fs::read(dir.join("dataset.npz")).unwrap();
     assert_eq!(bytes(&copied), bytes(straight));
-    // a copied run at another place than its batch plans (ad01-01 holding ad01-02's palpation)
-    // is solved again, with a note, and the dataset is the same
+    // a copied run at another place than its batch plans (ad01-01 holding ad01-02's
+    // palpation), or than the initial design plans (S01 holding S02's), is solved again, with
+    // a note, and the dataset is the same
     let wrong = copy_runs(straight, "wrong");
     let scene = |l: &str| wrong.join("runs").join(l).join("scene.toml");
-    let other = std::fs::read_to_string(scene("ad01-02")).unwrap();
-    std::fs::write(scene("ad01-01"), other.replace("ad01-02", "ad01-01")).unwrap();
+    for (at, from) in [("ad01-01", "ad01-02"), ("S01", "S02")] {
+        let other = std::fs::read_to_string(scene(from)).unwrap();
+        std::fs::write(scene(at), other.replace(from, at)).unwrap();
+    }
     let mut args = vec!["campaign", s(file), "--out", s(&wrong), "--resume"];
     args.extend(flags);
     let o = palpa(&args);
@@ -93,6 +107,8 @@ fn batch_runs_copied_in_are_reused(file: &Path, straight: &Path, flags: &[&str])
     assert!(
         o.status.success()
             && err.contains("ad01-01/scene.toml is not the palpation adaptive batch 1 plans")
+            && err.contains("S01/scene.toml is not the palpation this campaign plans for S01")
+            && out.contains("4 finished, 1 to run")
             && out.contains("6 finished, 1 to run"),
         "{out}{err}"
     );

@@ -15,6 +15,19 @@ use std::collections::BTreeMap;
 use std::path::Path;
 pub use surrogate::Split;
 
+/// Whether two scene files (TOML) give the same palpation: the same tables and values, whatever
+/// their layout, once `[run] title` is left out of both; an unreadable one is never the same.
+fn same_palpation(a: &str, b: &str) -> bool {
+    let untitled = |s: &str| {
+        let mut t: toml::Table = s.parse().ok()?;
+        if let Some(run) = t.get_mut("run").and_then(|r| r.as_table_mut()) {
+            run.remove("title");
+        }
+        Some(t)
+    };
+    matches!((untitled(a), untitled(b)), (Some(x), Some(y)) if x == y)
+}
+
 /// A respiratory run's file of its ROI: the element ids of its own mesh that carry the
 /// reference ROI's points, in the ROI's order (`{"roi_elements": [...]}`).
 pub const ROI_MAP_FILE: &str = "roi_map.json";
@@ -70,11 +83,14 @@ impl Campaign {
             .collect()
     }
 
-    /// Whether the run directory of `r` in `out` holds the scene this plan gives `r` (its
-    /// `scene.toml`, as [`Campaign::setup`] writes it).
+    /// Whether the run directory of `r` in `out` holds the palpation this plan gives `r`: its
+    /// `scene.toml` equals the one [`Campaign::setup`] writes, key for key, but for the run's
+    /// title (which names the campaign: a run copied from another campaign that plans the same
+    /// palpation, e.g. a Sobol design's first points into an adaptive one, is the same run).
     pub fn is_run_as_planned(&self, out: &std::path::Path, r: &PlannedRun) -> bool {
         let path = crate::run_files::run_dir(out, &r.label).join("scene.toml");
-        std::fs::read_to_string(path).ok() == Some(self.setup(r).scene_toml())
+        std::fs::read_to_string(path)
+            .is_ok_and(|there| same_palpation(&there, &self.setup(r).scene_toml()))
     }
 
     /// The palpation of run `r`.
@@ -385,5 +401,20 @@ impl CampaignPlan {
             .iter()
             .find(|r| r.label == label)
             .ok_or_else(|| format!("campaign.json: no run `{label}`"))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::same_palpation;
+
+    #[test]
+    fn a_palpation_is_the_same_whatever_its_title_and_layout() {
+        let a = "[run]\ntitle = \"Sobol: S001\"\nend_time = \"0.025 s\"\n\n[[hand]]\nat = [\"0.1 m\", \"0.2 m\"]\n";
+        let b = "[run]\nend_time = \"0.025 s\"\ntitle = \"adaptive: S001\"\n[[hand]]\nat = [ \"0.1 m\", \"0.2 m\" ]\n";
+        assert!(same_palpation(a, b));
+        assert!(!same_palpation(a, &b.replace("0.2 m", "0.21 m")));
+        assert!(!same_palpation(a, &b.replace("0.025 s", "0.03 s")));
+        assert!(!same_palpation(a, "[run\n"));
     }
 }

@@ -8,9 +8,10 @@
 //! - `runs/<label>/`: one palpation each (`scene.toml`, `probe.csv`, `probe_stress.csv`,
 //!   `history.csv`, `summary.json`), finished when `done.json` exists (written last,
 //!   atomically); `--resume` skips finished runs and redoes any other run directory from
-//!   scratch; with `--adaptive`, a new batch's runs already finished there are reused when
-//!   their `scene.toml` is the palpation the batch plans (copied from a campaign that chose the
-//!   same batches), and solved again otherwise;
+//!   scratch. Runs copied into a directory without `campaign.json`, and with `--adaptive` a new
+//!   batch's runs already finished there, are reused when their `scene.toml` is the palpation
+//!   the plan gives them ([`Campaign::is_run_as_planned`]: copied from a campaign that plans the
+//!   same runs or chose the same batches), and solved again otherwise;
 //! - `view.json`: the phantom in plan view (outlines, ROI cells, the hand;
 //!   [`surrogate::ViewGeometry`]), which `palpa train` puts beside the model;
 //! - `dataset.npz` + `manifest.json` (also as `dataset.json`, so that both `palpa train DIR` and
@@ -153,9 +154,15 @@ fn run_campaign(a: &CampaignArgs) -> Result<(), String> {
     let plan = campaign.plan(&phantom, &locs);
     let mine = campaign.runs_of(shard);
     let out = &a.out;
+    // runs copied into a new --out (no campaign.json yet) are reused only when they hold the
+    // palpation this plan gives them; a resumed directory's campaign.json already says so
+    let copied = !out.join(campaign::CAMPAIGN_FILE).exists();
     let done: Vec<bool> = mine
         .iter()
-        .map(|r| campaign::is_finished(out, &r.label))
+        .map(|r| {
+            campaign::is_finished(out, &r.label)
+                && (!copied || is_reusable(&campaign, out, r, "this campaign"))
+        })
         .collect();
     let n_done = done.iter().filter(|&&d| d).count();
 
@@ -351,24 +358,28 @@ fn run_and_grow(
         // a batch's runs already finished in --out (copied from a campaign that chose the
         // same batch) are reused when their scene is the palpation the batch plans; any other
         // is solved again
-        let (reused, new): (Vec<PlannedRun>, Vec<PlannedRun>) = campaign.runs[first_new..]
-            .iter()
-            .cloned()
-            .partition(|r| {
-                let finished = campaign::is_finished(out, &r.label);
-                let same = campaign.is_run_as_planned(out, r);
-                if finished && !same {
-                    eprintln!(
-                        "note: {} is not the palpation adaptive batch {number} plans for {} (another location, setting or palpa version): it is solved again",
-                        campaign::run_dir(out, &r.label).join("scene.toml").display(),
-                        r.label
-                    );
-                }
-                finished && same
+        let (reused, new): (Vec<PlannedRun>, Vec<PlannedRun>) =
+            campaign.runs[first_new..].iter().cloned().partition(|r| {
+                campaign::is_finished(out, &r.label)
+                    && is_reusable(campaign, out, r, &format!("adaptive batch {number}"))
             });
         st.n_done += reused.len();
         todo = new;
     }
+}
+
+/// Whether the finished run of `r` in `out` holds the palpation `planner` plans for it
+/// ([`Campaign::is_run_as_planned`]); when not, says so on stderr: it is solved again.
+fn is_reusable(campaign: &Campaign, out: &Path, r: &PlannedRun, planner: &str) -> bool {
+    let same = campaign.is_run_as_planned(out, r);
+    if !same {
+        eprintln!(
+            "note: {} is not the palpation {planner} plans for {} (another location or setting): it is solved again",
+            campaign::run_dir(out, &r.label).join("scene.toml").display(),
+            r.label
+        );
+    }
+    same
 }
 
 /// Run `todo` (a share of the campaign's runs) and write the dataset when every run of the
