@@ -787,7 +787,8 @@ fn likelihood_rows_reach_the_gp(tmp: &Path, campaign: &Path) {
 }
 
 /// `--with FRONT.csv` puts an earlier front's rows, as written, before the new design's; a point
-/// (design, runs) may not be given twice, by a new design or by two fronts.
+/// (design, runs) may not be given twice, by a new design or by two fronts, and a front of other
+/// settings (target, likelihood rows) is refused.
 fn earlier_front_joins_a_new_one(tmp: &Path, campaign: &Path) {
     let earlier = tmp.join("whole/front.csv");
     let joined = tmp.join("joined");
@@ -840,6 +841,39 @@ fn earlier_front_joins_a_new_one(tmp: &Path, campaign: &Path) {
         !o.status.success() && err.contains("design `d` at 1 runs is given twice"),
         "{err}"
     );
+    // the earlier front learned the element stress from every sample: a recovered front, or
+    // one with another likelihood cap, refuses it, naming both settings
+    for (flag, value, here) in [
+        (
+            "--recover",
+            "5 mm",
+            "recovered H = 5 mm; every sample; 600 likelihood rows",
+        ),
+        (
+            "--likelihood-rows",
+            "300",
+            "element stress; every sample; 300 likelihood rows",
+        ),
+    ] {
+        let o = palpa(&[
+            "front",
+            "e=x",
+            flag,
+            value,
+            "--with",
+            s(&earlier),
+            "--out",
+            s(&joined),
+        ]);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(
+            !o.status.success()
+                && err.contains(&format!(
+                    "d at 1 runs was measured with element stress; every sample; 600 likelihood rows, this front with {here}"
+                )),
+            "{err}"
+        );
+    }
 }
 
 /// `palpa front` on a campaign still running (no dataset.npz) reads its finished runs: the
@@ -863,11 +897,15 @@ fn front_reads_the_finished_runs_of_a_running_campaign() {
             s(&dir),
         ]);
         let csv = std::fs::read_to_string(dir.join("front.csv")).unwrap_or_default();
-        // the rows without their last cell, the GP's training time
+        // the rows without the GP's training time (the 9th cell)
         let rows: Vec<String> = csv
             .lines()
             .skip(1)
-            .map(|l| l.rsplit_once(',').unwrap().0.to_string())
+            .map(|l| {
+                let mut cells: Vec<&str> = l.split(',').collect();
+                cells.remove(8);
+                cells.join(",")
+            })
             .collect();
         (o, rows)
     };

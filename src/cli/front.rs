@@ -14,8 +14,10 @@
 //! time. A campaign still running (no `dataset.npz` yet) is read from its finished runs
 //! ([`campaign::assemble_finished`]). `--recover H` trains and scores on the recovered stress target
 //! ([`surrogate::recovery`]) instead of the element stress. `--with FRONT.csv` adds an earlier
-//! front's rows ([`super::front_row`]) to the table and the plot. Written as `front.csv`,
-//! `front.md` and `front.png` (Fit against runs, one line per design), each atomically.
+//! front's rows ([`super::front_row`]) to the table and the plot; each row records its settings
+//! (target, training samples, likelihood rows), and rows of other settings are refused. Written
+//! as `front.csv`, `front.md` and `front.png` (Fit against runs, one line per design), each
+//! atomically.
 
 use super::front_row::{Row, CSV_HEADER};
 use super::train::check_dataset_path;
@@ -58,7 +60,8 @@ pub fn run(a: &FrontArgs) -> Result<(), String> {
     if a.runs.contains(&0) {
         return Err("--runs: counts must be at least 1".into());
     }
-    let mut rows = Row::read_fronts(&a.with)?;
+    let settings = a.target.settings(&options.gp)?;
+    let mut rows = Row::read_fronts(&a.with, &settings)?;
     let earlier = rows.len();
     // every design read before any is trained, so that a bad one stops the front at once
     let mut designs: Vec<(String, PathBuf, Vec<usize>, Dataset, bool)> = Vec::new();
@@ -82,7 +85,7 @@ pub fn run(a: &FrontArgs) -> Result<(), String> {
     std::fs::create_dir_all(&a.out)
         .map_err(|e| format!("{}: cannot create: {e}", a.out.display()))?;
     println!(
-        "  GP hyperparameters by the marginal likelihood of at most {} training rows",
+        "  GP hyperparameters by the marginal likelihood of at most {} training rows; settings: {settings}",
         options.gp.max_likelihood_rows
     );
     for (name, dir, runs, data, partial) in &designs {
@@ -106,7 +109,15 @@ pub fn run(a: &FrontArgs) -> Result<(), String> {
                 recovery_width,
                 ignore_phase: a.target.ignore_phase,
             };
-            let row = point(name, dir, data, &order[..n], &selection, &options)?;
+            let row = point(
+                name,
+                dir,
+                data,
+                &order[..n],
+                &selection,
+                &options,
+                &settings,
+            )?;
             println!(
                 "  {name:<10} {n:>4} runs, {:.3} core-h: held-out Fit {:.4} (A, B, C {}, others {}), at the paper's stamps {:.4}, 95 % coverage {}, trained in {:.1} s",
                 row.core_hours,
@@ -123,7 +134,7 @@ pub fn run(a: &FrontArgs) -> Result<(), String> {
     if rows.len() == earlier {
         return Err("no point of the front: every run count exceeds its design's training locations (the skipped counts are listed above)".to_string());
     }
-    write_outputs(&a.out, &rows)
+    write_outputs(&a.out, &rows, &settings)
 }
 
 /// A design's dataset: its `dataset.npz`, or, for a campaign still running (its `campaign.json`
@@ -207,6 +218,7 @@ fn point(
     locs: &[i64],
     selection: &surrogate::TrainingSelection,
     options: &TrainOptions,
+    settings: &str,
 ) -> Result<Row, String> {
     let sel = selection
         .apply(data)
@@ -249,6 +261,7 @@ fn point(
             .unwrap_or(f64::NAN),
         coverage: report.test_coverage_95,
         train_seconds: report.train_seconds,
+        settings: Some(settings.to_string()),
     })
 }
 
@@ -267,13 +280,13 @@ fn training_seconds(dir: &Path, data: &Dataset, locs: &[i64]) -> Result<f64, Str
     Ok(seconds)
 }
 
-fn write_outputs(out: &Path, rows: &[Row]) -> Result<(), String> {
+fn write_outputs(out: &Path, rows: &[Row], settings: &str) -> Result<(), String> {
     let mut csv = format!("{CSV_HEADER}\n");
-    let mut md = String::from(
-        "| design | runs | solver core-h | held-out Fit | A, B, C | other held-out | at the paper's stamps | 95 % coverage | GP training (s) |\n|---|---:|---:|---:|---:|---:|---:|---:|---:|\n",
+    let mut md = format!(
+        "Settings: {settings}.\n\n| design | runs | solver core-h | held-out Fit | A, B, C | other held-out | at the paper's stamps | 95 % coverage | GP training (s) |\n|---|---:|---:|---:|---:|---:|---:|---:|---:|\n",
     );
     for r in rows {
-        let _ = writeln!(csv, "{}", r.cells(false).join(","));
+        let _ = writeln!(csv, "{}", r.csv_cells().join(","));
         let _ = writeln!(md, "| {} |", r.cells(true).join(" | "));
     }
     let write = |name: &str, text: &str| {

@@ -1,12 +1,19 @@
 //! One point of `palpa front`: its cells as `front.csv` and `front.md` write them, and a row
 //! read back from an earlier `front.csv` (`--with`), so that a front measured in another sitting
-//! is drawn beside new designs without its campaigns.
+//! is drawn beside new designs without its campaigns. Each row carries the settings it was
+//! measured with (target, training samples, likelihood rows; [`super::selection`]), and `--with`
+//! refuses rows measured with other settings than the front's own: their Fits are not
+//! comparable. A `front.csv` written before the `settings` column (9 columns) is read with its
+//! settings unknown, said on stderr.
 
 use std::path::Path;
 
-/// `front.csv`'s header; `--with` reads files that start with it.
+/// `front.csv`'s header; `--with` reads files that start with it, or with its first 9 columns.
 pub const CSV_HEADER: &str =
-    "design,runs,core_hours,fit_heldout,fit_abc,fit_other,fit_paper_times,coverage_95,train_seconds";
+    "design,runs,core_hours,fit_heldout,fit_abc,fit_other,fit_paper_times,coverage_95,train_seconds,settings";
+
+/// The columns of a `front.csv` written before the `settings` column.
+const COLUMNS_BEFORE_SETTINGS: usize = 9;
 
 /// One point of the front.
 #[derive(Clone, Debug, PartialEq)]
@@ -29,11 +36,21 @@ pub struct Row {
     pub coverage: Option<f64>,
     /// The GP's training time (s).
     pub train_seconds: f64,
+    /// What the model learned and how ([`super::selection::SampleTargetArgs::settings`]);
+    /// `None` for a row of a `front.csv` that does not record them.
+    pub settings: Option<String>,
 }
 
 impl Row {
-    /// The row's cells as `front.csv` (`md` false) or `front.md` (coverage in %, fewer digits)
-    /// writes them.
+    /// The row's cells as `front.csv` writes them.
+    pub fn csv_cells(&self) -> Vec<String> {
+        let mut cells = self.cells(false).to_vec();
+        cells.push(self.settings.clone().unwrap_or_else(|| "unknown".into()));
+        cells
+    }
+
+    /// The row's measured cells as `front.csv` (`md` false) or `front.md` (coverage in %, fewer
+    /// digits) writes them.
     pub fn cells(&self, md: bool) -> [String; 9] {
         let o = |v: Option<f64>| v.map_or(String::new(), |f| format!("{f:.4}"));
         let coverage = if md {
@@ -64,11 +81,35 @@ impl Row {
     }
 
     /// The rows of the earlier fronts at `paths` (`--with`), in order; a point (design and run
-    /// count) given twice is refused.
-    pub fn read_fronts(paths: &[std::path::PathBuf]) -> Result<Vec<Row>, String> {
+    /// count) given twice is refused, and so is a row measured with other `settings`.
+    pub fn read_fronts(paths: &[std::path::PathBuf], settings: &str) -> Result<Vec<Row>, String> {
         let mut rows: Vec<Row> = Vec::new();
         for path in paths {
-            let more = Row::read_csv(path)?;
+            let mut more = Row::read_csv(path)?;
+            if let Some(r) = more.iter().find(|r| r.settings.is_none()) {
+                eprintln!(
+                    "  note: --with {} records no settings (a front.csv older than its `settings` column): its rows, e.g. {} at {} runs, are drawn as if measured with {settings}",
+                    path.display(),
+                    r.design,
+                    r.runs
+                );
+            }
+            for r in more.iter_mut().filter(|r| r.settings.is_none()) {
+                r.settings = Some(settings.to_string());
+            }
+            if let Some((r, there)) = more.iter().find_map(|r| {
+                r.settings
+                    .as_deref()
+                    .filter(|&s| s != settings)
+                    .map(|s| (r, s))
+            }) {
+                return Err(format!(
+                    "--with {}: {} at {} runs was measured with {there}, this front with {settings}: their Fits are not comparable (give the same --recover, --train-interval, --likelihood-rows and --ignore-phase)",
+                    path.display(),
+                    r.design,
+                    r.runs
+                ));
+            }
             for (k, r) in more.iter().enumerate() {
                 let twice = |o: &Row| o.design == r.design && o.runs == r.runs;
                 if rows.iter().chain(&more[..k]).any(twice) {
@@ -91,28 +132,36 @@ impl Row {
         let text = std::fs::read_to_string(path)
             .map_err(|e| format!("--with {}: cannot read: {e}", path.display()))?;
         let mut lines = text.lines().enumerate();
-        match lines.next() {
-            Some((_, h)) if h.trim() == CSV_HEADER => {}
+        let columns = match lines.next() {
+            Some((_, h)) if h.trim() == CSV_HEADER => CSV_HEADER.split(',').count(),
+            Some((_, h))
+                if h.trim()
+                    .split(',')
+                    .eq(CSV_HEADER.split(',').take(COLUMNS_BEFORE_SETTINGS)) =>
+            {
+                COLUMNS_BEFORE_SETTINGS
+            }
             _ => {
                 return Err(format!(
                     "--with {}:1: not a front.csv (its header must be `{CSV_HEADER}`)",
                     path.display()
                 ))
             }
-        }
+        };
         lines
             .filter(|(_, l)| !l.trim().is_empty())
             .map(|(i, l)| {
-                Row::parse(l).map_err(|e| format!("--with {}:{}: {e}", path.display(), i + 1))
+                Row::parse(l, columns)
+                    .map_err(|e| format!("--with {}:{}: {e}", path.display(), i + 1))
             })
             .collect()
     }
 
-    /// One data line of `front.csv`.
-    fn parse(line: &str) -> Result<Row, String> {
+    /// One data line of a `front.csv` of `columns` columns.
+    fn parse(line: &str, columns: usize) -> Result<Row, String> {
         let cells: Vec<&str> = line.split(',').map(str::trim).collect();
-        if cells.len() != 9 {
-            return Err(format!("{} cells, the header has 9", cells.len()));
+        if cells.len() != columns {
+            return Err(format!("{} cells, the header has {columns}", cells.len()));
         }
         let names: Vec<&str> = CSV_HEADER.split(',').collect();
         let num = |k: usize| {
@@ -138,6 +187,10 @@ impl Row {
             fit_paper_times: num(6)?,
             coverage: maybe(7)?,
             train_seconds: num(8)?,
+            settings: match cells.get(9) {
+                Some(s) if s.is_empty() => return Err("settings: empty".into()),
+                s => s.map(|s| s.to_string()),
+            },
         })
     }
 }
@@ -158,12 +211,36 @@ mod tests {
             fit_paper_times: 0.9358,
             coverage: Some(0.9101),
             train_seconds: 50.16,
+            settings: Some("element stress; every sample; 600 likelihood rows".into()),
         };
         let dir = tempfile::tempdir().unwrap();
         let path = dir.path().join("front.csv");
-        let line = row.cells(false).join(",");
+        let line = row.csv_cells().join(",");
         std::fs::write(&path, format!("{CSV_HEADER}\n{line}\n")).unwrap();
-        assert_eq!(Row::read_csv(&path).unwrap(), vec![row]);
+        assert_eq!(Row::read_csv(&path).unwrap(), vec![row.clone()]);
+        // the same settings are read back, other settings are refused by name
+        let paths = [path.clone()];
+        assert_eq!(
+            Row::read_fronts(&paths, "element stress; every sample; 600 likelihood rows")
+                .unwrap()
+                .len(),
+            1
+        );
+        let err = Row::read_fronts(
+            &paths,
+            "recovered H = 5 mm; every sample; 600 likelihood rows",
+        )
+        .unwrap_err();
+        assert!(
+            err.contains("sobol at 25 runs was measured with element stress; every sample; 600 likelihood rows, this front with recovered"),
+            "{err}"
+        );
+        // a front.csv of 9 columns reads with its settings unknown
+        let old = CSV_HEADER.rsplit_once(',').unwrap().0;
+        std::fs::write(&path, format!("{old}\n{}\n", row.cells(false).join(","))).unwrap();
+        let read = Row::read_csv(&path).unwrap();
+        assert_eq!(read[0].settings, None);
+        assert_eq!(read[0].fit_all, row.fit_all);
         std::fs::write(
             &path,
             format!("{CSV_HEADER}\n{}\n", line.replace("0.9433", "x")),

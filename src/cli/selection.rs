@@ -52,6 +52,27 @@ impl SampleTargetArgs {
         }
     }
 
+    /// What a model trained with these options learns and how, in one line that `palpa front`
+    /// records beside each point: the target, the training samples, the GP's likelihood rows
+    /// (`gp`, after [`Self::set_likelihood_rows`]) and whether the phase input is left out, e.g.
+    /// `element stress; every sample; 600 likelihood rows`.
+    pub fn settings(&self, gp: &surrogate::gp::GpOptions) -> Result<String, String> {
+        let short = |v: f64| format!("{}", (v * 1e6).round() / 1e3);
+        let mut s = match self.recovery_width()? {
+            Some(h) => format!("recovered H = {} mm", short(h)),
+            None => "element stress".into(),
+        };
+        match self.interval()? {
+            Some(dt) => s += &format!("; samples every {} ms", short(dt)),
+            None => s += "; every sample",
+        }
+        s += &format!("; {} likelihood rows", gp.max_likelihood_rows);
+        if self.ignore_phase {
+            s += "; phase ignored";
+        }
+        Ok(s)
+    }
+
     /// `--recover` in m.
     pub fn recovery_width(&self) -> Result<Option<f64>, String> {
         self.recover
