@@ -734,6 +734,38 @@ fn phase_model_takes_the_phase(tmp: &Path, breath: &Path, plain: &Path, d: &Data
     assert!(e.contains("takes x, y and force only"), "{r:?}");
 }
 
+/// `palpa train --leave-out P07` learns from P12 alone (3 samples); a label that is not a
+/// training location (the held-out A, or one not among the first --train-locations) is named.
+fn left_out_locations_are_not_learned(tmp: &Path, campaign: &Path) {
+    let model = tmp.join("gp-left-out");
+    let train = |more: &[&str]| {
+        let mut args = vec!["train", s(campaign), "--model", "gp", "--out", s(&model)];
+        args.extend(more);
+        palpa(&args)
+    };
+    let o = train(&["--leave-out", "P07"]);
+    let text = String::from_utf8_lossy(&o.stdout);
+    assert!(
+        o.status.success() && text.contains("3 training samples from 1 locations"),
+        "{text}{}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    for (more, label) in [
+        (&["--leave-out", "A"][..], "A"),
+        (&["--train-locations", "1", "--leave-out", "P12"][..], "P12"),
+    ] {
+        let o = train(more);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert!(
+            !o.status.success()
+                && err.contains(&format!(
+                    "`{label}` is not a training location of the selection"
+                )),
+            "{err}"
+        );
+    }
+}
+
 /// `--likelihood-rows N` caps the rows of the GP's hyperparameter search at N (the trained
 /// model says how many it took), and fewer than 2 rows are refused naming the flag.
 fn likelihood_rows_reach_the_gp(tmp: &Path, campaign: &Path) {
@@ -886,6 +918,7 @@ fn front_reads_the_finished_runs_of_a_running_campaign() {
     let out = tmp.path().join("c");
     ok(&["campaign", s(&file), "--out", s(&out), "--quiet"]);
     likelihood_rows_reach_the_gp(tmp.path(), &out);
+    left_out_locations_are_not_learned(tmp.path(), &out);
     let front = |name: &str| {
         let dir = tmp.path().join(name);
         let o = palpa(&[

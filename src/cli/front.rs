@@ -108,6 +108,7 @@ pub fn run(a: &FrontArgs) -> Result<(), String> {
                 interval,
                 recovery_width,
                 ignore_phase: a.target.ignore_phase,
+                leave_out: Vec::new(),
             };
             let row = point(
                 name,

@@ -104,6 +104,11 @@ pub struct TrainArgs {
     /// the first N points of a Sobol design are themselves a design [default: all].
     #[arg(long, value_name = "N")]
     pub train_locations: Option<usize>,
+    /// Leave these training locations out, by label, comma-separated (after
+    /// --train-locations): what a run does to the model, e.g. `--train-locations 60 --leave-out
+    /// ad05-08`.
+    #[arg(long, value_name = "LABEL,..", value_delimiter = ',')]
+    pub leave_out: Vec<String>,
     #[command(flatten)]
     pub sample_target: super::selection::SampleTargetArgs,
     /// Worker threads of the global pool [default: all cores]. The trainers themselves run on
@@ -224,6 +229,7 @@ pub fn train(a: &TrainArgs) -> Result<(), String> {
         interval,
         recovery_width,
         ignore_phase: a.sample_target.ignore_phase,
+        leave_out: a.leave_out.clone(),
     };
     let report = surrogate::train_selected(&a.dataset, &selection, kind, &opts, &a.out)
         .map_err(|e| format!("train {}: {e}", a.dataset.display()))?;

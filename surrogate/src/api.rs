@@ -66,7 +66,7 @@ pub fn train(
 
 /// Which training samples of a dataset a model learns from ([`Dataset::select_training`]);
 /// the default keeps them all.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[derive(Clone, Debug, Default, PartialEq)]
 pub struct TrainingSelection {
     /// Only the first n training locations, in the dataset's order.
     pub first_locations: Option<usize>,
@@ -78,12 +78,18 @@ pub struct TrainingSelection {
     /// Drop a respiratory dataset's `phase` column, so that the model takes x, y and force
     /// only (what the phase input buys, measured on the same runs).
     pub ignore_phase: bool,
+    /// Training locations left out, by label, after `first_locations`
+    /// ([`Dataset::without_training_locations`]).
+    pub leave_out: Vec<String>,
 }
 
 impl TrainingSelection {
     /// The dataset this selection trains on: its training samples, and its target.
     pub fn apply(&self, data: &Dataset) -> Result<Dataset> {
         let mut d = data.select_training(self.first_locations, self.interval)?;
+        if !self.leave_out.is_empty() {
+            d = d.without_training_locations(&self.leave_out)?;
+        }
         if self.ignore_phase {
             d = d.without_column("phase");
         }

@@ -225,16 +225,54 @@ impl Dataset {
                 "keeps no training sample",
             ));
         }
-        Ok(Dataset {
-            x: self.x.select(Axis(0), &rows),
-            y: self.y.select(Axis(0), &rows),
-            stress: self.stress.as_ref().map(|s| s.select(Axis(0), &rows)),
+        Ok(self.rows(&rows))
+    }
+
+    /// The dataset without the training samples of the locations labelled `labels` (test
+    /// samples untouched): what one run, or a few, does to a model, e.g. a batch's point that
+    /// lowers the Fit of a held-out location beside it (docs/surrogate.md). An error names a
+    /// label that is not a training location here, and a selection that keeps no training sample.
+    pub fn without_training_locations(&self, labels: &[String]) -> Result<Dataset> {
+        let order = self.training_location_order();
+        let mut drop: Vec<i64> = Vec::new();
+        for l in labels {
+            let id = order
+                .iter()
+                .find(|&&id| self.location_label(id) == *l)
+                .ok_or_else(|| {
+                    Error::invalid(
+                        "leave out",
+                        format!("`{l}` is not a training location of the selection"),
+                    )
+                })?;
+            drop.push(*id);
+        }
+        let rows: Vec<usize> = (0..self.n_samples())
+            .filter(|&i| {
+                self.split[i] != crate::Split::Train.code() || !drop.contains(&self.location[i])
+            })
+            .collect();
+        if !rows
+            .iter()
+            .any(|&i| self.split[i] == crate::Split::Train.code())
+        {
+            return Err(Error::invalid("leave out", "keeps no training sample"));
+        }
+        Ok(self.rows(&rows))
+    }
+
+    /// The dataset of the samples `rows`, in that order.
+    fn rows(&self, rows: &[usize]) -> Dataset {
+        Dataset {
+            x: self.x.select(Axis(0), rows),
+            y: self.y.select(Axis(0), rows),
+            stress: self.stress.as_ref().map(|s| s.select(Axis(0), rows)),
             roi_ids: self.roi_ids.clone(),
             roi_centroids: self.roi_centroids.clone(),
-            location: self.location.select(Axis(0), &rows),
-            split: self.split.select(Axis(0), &rows),
+            location: self.location.select(Axis(0), rows),
+            split: self.split.select(Axis(0), rows),
             manifest: self.manifest.clone(),
-        })
+        }
     }
 
     /// The training locations in the order their first sample appears (a campaign's order).

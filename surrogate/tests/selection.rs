@@ -18,3 +18,47 @@ fn select_training_keeps_the_first_locations_and_stamps() {
     assert!(d.select_training(None, Some(-1.0)).is_err());
     assert_eq!(d.select_training(None, None).unwrap(), d);
 }
+
+/// Leaving training locations out drops their samples and only theirs (the test samples are
+/// untouched); a label that is not a training location, or leaving every one out, is an error
+/// that names it.
+#[test]
+fn training_locations_are_left_out_by_label() {
+    let d = make_synthetic_dataset(4);
+    let order = d.training_location_order();
+    let (first, second) = (d.location_label(order[0]), d.location_label(order[1]));
+    let s = d
+        .without_training_locations(&[first.clone(), second])
+        .unwrap();
+    let per_location = d.rows_with_split(Split::Train).len() / order.len();
+    assert_eq!(
+        s.rows_with_split(Split::Train).len(),
+        d.rows_with_split(Split::Train).len() - 2 * per_location
+    );
+    assert!(s
+        .rows_with_split(Split::Train)
+        .iter()
+        .all(|&i| s.location[i] != order[0] && s.location[i] != order[1]));
+    assert_eq!(
+        s.rows_with_split(Split::Test).len(),
+        d.rows_with_split(Split::Test).len()
+    );
+    let test_label = d.location_label(d.location[d.rows_with_split(Split::Test)[0]]);
+    let err = d
+        .without_training_locations(&[test_label.clone()])
+        .unwrap_err()
+        .to_string();
+    assert!(
+        err.contains(&format!("`{test_label}` is not a training location")),
+        "{err}"
+    );
+    let all: Vec<String> = order.iter().map(|&l| d.location_label(l)).collect();
+    let err = d.without_training_locations(&all).unwrap_err().to_string();
+    assert!(err.contains("keeps no training sample"), "{err}");
+    // after the first 3 locations, the 4th is not in the selection to leave out
+    let first3 = d.select_training(Some(3), None).unwrap();
+    assert!(first3
+        .without_training_locations(&[d.location_label(order[3])])
+        .is_err());
+    assert!(first3.without_training_locations(&[first]).is_ok());
+}
