@@ -97,17 +97,35 @@ fn batch_runs_copied_in_are_reused(file: &Path, straight: &Path, flags: &[&str])
         let other = std::fs::read_to_string(scene(from)).unwrap();
         std::fs::write(scene(at), other.replace(from, at)).unwrap();
     }
-    let mut args = vec!["campaign", s(file), "--out", s(&wrong), "--resume"];
-    args.extend(flags);
-    let o = palpa(&args);
-    let (out, err) = (
-        String::from_utf8_lossy(&o.stdout),
-        String::from_utf8_lossy(&o.stderr),
-    );
+    let run = |more: &[&str]| {
+        let mut args = vec!["campaign", s(file), "--out", s(&wrong)];
+        args.extend(flags);
+        args.extend(more);
+        let o = palpa(&args);
+        let text = |b: &[u8]| String::from_utf8_lossy(b).into_owned();
+        (o.status.success(), text(&o.stdout), text(&o.stderr))
+    };
+    let s01_done = wrong.join("runs/S01/done.json");
+    // without --resume the directory of finished runs is refused, and nothing is removed
+    let (ok, _, err) = run(&[]);
     assert!(
-        o.status.success()
-            && err.contains("ad01-01/scene.toml is not the palpation adaptive batch 1 plans")
-            && err.contains("S01/scene.toml is not the palpation this campaign plans for S01")
+        !ok && err.contains("finished run(s) of this campaign: pass --resume"),
+        "{err}"
+    );
+    assert!(s01_done.is_file());
+    // a resume that runs nothing removes the wrong S01 at once, naming where it parts from the
+    // plan, so that no dataset or later resume takes it for finished
+    let (ok, _, err) = run(&["--resume", "--max-runs", "0"]);
+    assert!(
+        ok && err.contains(
+            "S01/scene.toml is not the palpation this campaign plans for S01 (scene.hand[0].at["
+        ),
+        "{err}"
+    );
+    assert!(!s01_done.exists() && !wrong.join("dataset.npz").exists());
+    let (ok, out, err) = run(&["--resume"]);
+    assert!(
+        ok && err.contains("ad01-01/scene.toml is not the palpation adaptive batch 1 plans")
             && out.contains("4 finished, 1 to run")
             && out.contains("6 finished, 1 to run"),
         "{out}{err}"

@@ -2,6 +2,7 @@
 //! shard and the [`CampaignPlan`]. A resumed campaign, the shards of a merge and a merge's target
 //! must agree on the plan; [`first_difference`] names where two plans part.
 
+use crate::difference::first_difference;
 use crate::json_file::{read_json, write_json};
 use crate::plan::CampaignPlan;
 use crate::shard::shard_in;
@@ -56,53 +57,6 @@ impl CampaignDir {
     }
 }
 
-/// Where two campaign plans first differ, for the message that refuses to mix them:
-/// `plan.locations[26].surface_m[0]: -0.0705 there, -0.0725 here`. `None` when equal.
-pub fn first_difference(there: &Value, here: &Value, path: &str) -> Option<String> {
-    let short = |v: &Value| {
-        let s = v.to_string();
-        if s.chars().count() > 60 {
-            format!("{}...", s.chars().take(57).collect::<String>())
-        } else {
-            s
-        }
-    };
-    match (there, here) {
-        (Value::Object(a), Value::Object(b)) => {
-            let mut keys: Vec<&String> = a.keys().chain(b.keys()).collect();
-            keys.sort();
-            keys.dedup();
-            keys.into_iter().find_map(|k| {
-                let (x, y) = (a.get(k), b.get(k));
-                match (x, y) {
-                    (Some(x), Some(y)) => first_difference(x, y, &format!("{path}.{k}")),
-                    _ => Some(format!(
-                        "{path}.{k}: {} there, {} here",
-                        x.map_or("absent".into(), short),
-                        y.map_or("absent".into(), short)
-                    )),
-                }
-            })
-        }
-        (Value::Array(a), Value::Array(b)) if a.len() == b.len() => a
-            .iter()
-            .zip(b)
-            .enumerate()
-            .find_map(|(i, (x, y))| first_difference(x, y, &format!("{path}[{i}]"))),
-        (Value::Array(a), Value::Array(b)) => Some(format!(
-            "{path}: {} entries there, {} here",
-            a.len(),
-            b.len()
-        )),
-        _ if there != here => Some(format!(
-            "{path}: {} there, {} here",
-            short(there),
-            short(here)
-        )),
-        _ => None,
-    }
-}
-
 /// Make `out` the directory of this campaign (`plan`, `shard`): create it, refuse one that holds
 /// another campaign (naming where the plans part) or finished runs without `resume`, and write
 /// `campaign.json`. `note` hears the solver version of the finished runs when it is not this
@@ -153,40 +107,4 @@ pub fn write_campaign_file(
         &out.join(CAMPAIGN_FILE),
         &campaign_file(&plan.to_value(), shard),
     )
-}
-
-#[cfg(test)]
-mod tests {
-    use super::first_difference;
-    use serde_json::json;
-
-    #[test]
-    fn first_difference_names_the_path_and_both_values() {
-        let there =
-            json!({"runs": [1, 2], "locations": [{"label": "A", "surface_m": [-0.0705, 0.1785]}]});
-        let mut here = there.clone();
-        assert_eq!(first_difference(&there, &here, "plan"), None);
-        here["locations"][0]["surface_m"][0] = json!(-0.0725);
-        assert_eq!(
-            first_difference(&there, &here, "plan").as_deref(),
-            Some("plan.locations[0].surface_m[0]: -0.0705 there, -0.0725 here")
-        );
-        here["runs"] = json!([1, 2, 3]);
-        here["title"] = json!("new");
-        // keys in sorted order: locations, runs, title
-        assert_eq!(
-            first_difference(&there, &here, "plan").as_deref(),
-            Some("plan.locations[0].surface_m[0]: -0.0705 there, -0.0725 here")
-        );
-        here["locations"] = there["locations"].clone();
-        assert_eq!(
-            first_difference(&there, &here, "plan").as_deref(),
-            Some("plan.runs: 2 entries there, 3 here")
-        );
-        here["runs"] = json!([1, 2]);
-        assert_eq!(
-            first_difference(&there, &here, "plan").as_deref(),
-            Some("plan.title: absent there, \"new\" here")
-        );
-    }
 }

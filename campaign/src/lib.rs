@@ -87,6 +87,7 @@
 mod adaptive;
 mod assemble;
 mod design;
+mod difference;
 mod dir;
 mod execute;
 mod finished;
@@ -107,10 +108,8 @@ pub use adaptive::{
 };
 pub use assemble::{assemble, write_dataset};
 pub use design::{default_extent, DesignKind, DesignSpec, Region, MAX_DESIGN_POINTS};
-pub use dir::{
-    campaign_file, first_difference, prepare_dir, read_campaign_dir, write_campaign_file,
-    CampaignDir,
-};
+pub use difference::first_difference;
+pub use dir::{campaign_file, prepare_dir, read_campaign_dir, write_campaign_file, CampaignDir};
 pub use execute::{execute, run_one, Parallelism, Report, RunEvent};
 pub use finished::{assemble_finished, finished_prefix, not_a_shard, FinishedPrefix, Prefix};
 pub use json_file::{read_json, write_json};
@@ -123,8 +122,8 @@ pub use plan::{
     PlanSettings, PlannedRun, Split,
 };
 pub use run_files::{
-    is_finished, read_done, read_run, run_dir, runs_dir, stray_runs, write_done, DoneMarker,
-    RunSamples,
+    discard_run, is_finished, read_done, read_run, run_dir, runs_dir, stray_runs, write_done,
+    DoneMarker, RunSamples,
 };
 pub use shard::{in_shard, parse_shard, recorded_shard, resolve_shard, shard_in};
 pub use spec::{

@@ -4,7 +4,8 @@
 //! one of them, else the error names the missing runs and their shards.
 
 use crate::assemble::{assemble, write_dataset};
-use crate::dir::{campaign_file, first_difference, read_campaign_dir, CampaignDir};
+use crate::difference::first_difference;
+use crate::dir::{campaign_file, read_campaign_dir, CampaignDir};
 use crate::json_file::{read_json, write_json};
 use crate::run_files::{is_finished, run_dir};
 use crate::{CAMPAIGN_FILE, DONE_FILE};

@@ -15,17 +15,24 @@ use std::collections::BTreeMap;
 use std::path::Path;
 pub use surrogate::Split;
 
-/// Whether two scene files (TOML) give the same palpation: the same tables and values, whatever
-/// their layout, once `[run] title` is left out of both; an unreadable one is never the same.
-fn same_palpation(a: &str, b: &str) -> bool {
-    let untitled = |s: &str| {
-        let mut t: toml::Table = s.parse().ok()?;
+/// Where scene file `there` (TOML) parts from `here` as a palpation: the first key whose value
+/// differs, whatever the files' layout, once `[run] title` is left out of both
+/// ([`crate::first_difference`]); `None` when they give the same palpation.
+fn palpation_difference(there: &str, here: &str) -> Option<String> {
+    let untitled = |s: &str| -> Result<serde_json::Value, String> {
+        let mut t: toml::Table = s
+            .parse()
+            .map_err(|e: toml::de::Error| format!("not a scene file: {}", e.message()))?;
         if let Some(run) = t.get_mut("run").and_then(|r| r.as_table_mut()) {
             run.remove("title");
         }
-        Some(t)
+        serde_json::to_value(t).map_err(|e| e.to_string())
     };
-    matches!((untitled(a), untitled(b)), (Some(x), Some(y)) if x == y)
+    match (untitled(there), untitled(here)) {
+        (Ok(x), Ok(y)) => crate::difference::first_difference(&x, &y, "scene"),
+        (Err(e), _) => Some(e),
+        (_, Err(e)) => Some(format!("the planned scene: {e}")),
+    }
 }
 
 /// A respiratory run's file of its ROI: the element ids of its own mesh that carry the
@@ -83,14 +90,17 @@ impl Campaign {
             .collect()
     }
 
-    /// Whether the run directory of `r` in `out` holds the palpation this plan gives `r`: its
-    /// `scene.toml` equals the one [`Campaign::setup`] writes, key for key, but for the run's
-    /// title (which names the campaign: a run copied from another campaign that plans the same
-    /// palpation, e.g. a Sobol design's first points into an adaptive one, is the same run).
-    pub fn is_run_as_planned(&self, out: &std::path::Path, r: &PlannedRun) -> bool {
+    /// Why the run directory of `r` in `out` does not hold the palpation this plan gives `r`;
+    /// `None` when it does: its `scene.toml` equals the one [`Campaign::setup`] writes, key for
+    /// key, but for the run's title (which names the campaign: a run copied from another
+    /// campaign that plans the same palpation, e.g. a Sobol design's first points into an
+    /// adaptive one, is the same run).
+    pub fn unlike_plan(&self, out: &std::path::Path, r: &PlannedRun) -> Option<String> {
         let path = crate::run_files::run_dir(out, &r.label).join("scene.toml");
-        std::fs::read_to_string(path)
-            .is_ok_and(|there| same_palpation(&there, &self.setup(r).scene_toml()))
+        match std::fs::read_to_string(path) {
+            Ok(there) => palpation_difference(&there, &self.setup(r).scene_toml()),
+            Err(e) => Some(format!("cannot read it: {e}")),
+        }
     }
 
     /// The palpation of run `r`.
@@ -406,15 +416,22 @@ impl CampaignPlan {
 
 #[cfg(test)]
 mod tests {
-    use super::same_palpation;
+    use super::palpation_difference;
 
     #[test]
     fn a_palpation_is_the_same_whatever_its_title_and_layout() {
         let a = "[run]\ntitle = \"Sobol: S001\"\nend_time = \"0.025 s\"\n\n[[hand]]\nat = [\"0.1 m\", \"0.2 m\"]\n";
         let b = "[run]\nend_time = \"0.025 s\"\ntitle = \"adaptive: S001\"\n[[hand]]\nat = [ \"0.1 m\", \"0.2 m\" ]\n";
-        assert!(same_palpation(a, b));
-        assert!(!same_palpation(a, &b.replace("0.2 m", "0.21 m")));
-        assert!(!same_palpation(a, &b.replace("0.025 s", "0.03 s")));
-        assert!(!same_palpation(a, "[run\n"));
+        assert_eq!(palpation_difference(a, b), None);
+        assert_eq!(
+            palpation_difference(a, &b.replace("0.2 m", "0.21 m")).as_deref(),
+            Some("scene.hand[0].at[1]: \"0.2 m\" there, \"0.21 m\" here")
+        );
+        assert_eq!(
+            palpation_difference(a, &b.replace("0.025 s", "0.03 s")).as_deref(),
+            Some("scene.run.end_time: \"0.025 s\" there, \"0.03 s\" here")
+        );
+        let bad = palpation_difference("[run\n", b).unwrap();
+        assert!(bad.starts_with("not a scene file"), "{bad}");
     }
 }

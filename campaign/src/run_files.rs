@@ -72,6 +72,14 @@ pub fn is_finished(out: &Path, label: &str) -> bool {
     read_done(&run_dir(out, label)).is_some()
 }
 
+/// Remove the run `label` from `out`: its directory goes, so that nothing (the dataset, a
+/// later `--resume`, `palpa front`) takes it for finished; for a copied run that is not the
+/// palpation planned for it.
+pub fn discard_run(out: &Path, label: &str) -> Result<(), String> {
+    let dir = run_dir(out, label);
+    std::fs::remove_dir_all(&dir).map_err(|e| format!("{}: cannot remove: {e}", dir.display()))
+}
+
 /// The marker of a finished run in `dir`, if there is a readable one.
 pub fn read_done(dir: &Path) -> Option<DoneMarker> {
     let s = std::fs::read_to_string(dir.join(DONE_FILE)).ok()?;

@@ -154,15 +154,15 @@ fn run_campaign(a: &CampaignArgs) -> Result<(), String> {
     let plan = campaign.plan(&phantom, &locs);
     let mine = campaign.runs_of(shard);
     let out = &a.out;
-    // runs copied into a new --out (no campaign.json yet) are reused only when they hold the
-    // palpation this plan gives them; a resumed directory's campaign.json already says so
-    let copied = !out.join(campaign::CAMPAIGN_FILE).exists();
+    let finished: Vec<bool> = mine
+        .iter()
+        .map(|r| campaign::is_finished(out, &r.label))
+        .collect();
+    let unlike = copied_runs_unlike_plan(&campaign, out, &mine);
     let done: Vec<bool> = mine
         .iter()
-        .map(|r| {
-            campaign::is_finished(out, &r.label)
-                && (!copied || is_reusable(&campaign, out, r, "this campaign"))
-        })
+        .zip(&finished)
+        .map(|(r, &f)| f && !unlike.iter().any(|u| u.0 == r.label))
         .collect();
     let n_done = done.iter().filter(|&&d| d).count();
 
@@ -190,8 +190,17 @@ fn run_campaign(a: &CampaignArgs) -> Result<(), String> {
             campaign::write_campaign_file(out, &plan, None)?;
         }
     }
+    // copied runs that are not this plan's palpations go before campaign.json claims the
+    // directory's runs and before anything reads them (without --resume, prepare_dir refuses
+    // a directory with finished runs, and nothing is removed)
+    if a.resume {
+        for (label, why) in &unlike {
+            discard_unlike(out, label, "this campaign", why)?;
+        }
+    }
     // campaign.json: a resumed campaign must be the same campaign.
-    campaign::prepare_dir(out, &plan, shard, n_done, a.resume, &mut |v| {
+    let n_finished = finished.iter().filter(|&&f| f).count();
+    campaign::prepare_dir(out, &plan, shard, n_finished, a.resume, &mut |v| {
         if !a.quiet {
             println!(
                 "  note: the finished runs in {} were made by palpa {v}, this is {}",
@@ -358,28 +367,45 @@ fn run_and_grow(
         // a batch's runs already finished in --out (copied from a campaign that chose the
         // same batch) are reused when their scene is the palpation the batch plans; any other
         // is solved again
-        let (reused, new): (Vec<PlannedRun>, Vec<PlannedRun>) =
-            campaign.runs[first_new..].iter().cloned().partition(|r| {
-                campaign::is_finished(out, &r.label)
-                    && is_reusable(campaign, out, r, &format!("adaptive batch {number}"))
-            });
-        st.n_done += reused.len();
-        todo = new;
+        todo = Vec::new();
+        for r in &campaign.runs[first_new..] {
+            if !campaign::is_finished(out, &r.label) {
+                todo.push(r.clone());
+            } else if let Some(why) = campaign.unlike_plan(out, r) {
+                discard_unlike(out, &r.label, &format!("adaptive batch {number}"), &why)?;
+                todo.push(r.clone());
+            } else {
+                st.n_done += 1;
+            }
+        }
     }
 }
 
-/// Whether the finished run of `r` in `out` holds the palpation `planner` plans for it
-/// ([`Campaign::is_run_as_planned`]); when not, says so on stderr: it is solved again.
-fn is_reusable(campaign: &Campaign, out: &Path, r: &PlannedRun, planner: &str) -> bool {
-    let same = campaign.is_run_as_planned(out, r);
-    if !same {
-        eprintln!(
-            "note: {} is not the palpation {planner} plans for {} (another location or setting): it is solved again",
-            campaign::run_dir(out, &r.label).join("scene.toml").display(),
-            r.label
-        );
+/// The finished runs of `mine` copied into `out` before it held a `campaign.json` that are not
+/// the palpation the plan gives them, with the reason ([`Campaign::unlike_plan`]); none in a
+/// directory this campaign made (its `campaign.json` already says its runs are its own).
+fn copied_runs_unlike_plan(
+    campaign: &Campaign,
+    out: &Path,
+    mine: &[&PlannedRun],
+) -> Vec<(String, String)> {
+    if out.join(campaign::CAMPAIGN_FILE).exists() {
+        return Vec::new();
     }
-    same
+    mine.iter()
+        .filter(|r| campaign::is_finished(out, &r.label))
+        .filter_map(|r| Some((r.label.clone(), campaign.unlike_plan(out, r)?)))
+        .collect()
+}
+
+/// Remove the finished run `label` from `out` and say why on stderr: its `scene.toml` is not
+/// the palpation `planner` plans for it (`why`), so it is solved again.
+fn discard_unlike(out: &Path, label: &str, planner: &str, why: &str) -> Result<(), String> {
+    eprintln!(
+        "note: {} is not the palpation {planner} plans for {label} ({why}): it is removed and solved again",
+        campaign::run_dir(out, label).join("scene.toml").display(),
+    );
+    campaign::discard_run(out, label)
 }
 
 /// Run `todo` (a share of the campaign's runs) and write the dataset when every run of the

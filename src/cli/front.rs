@@ -15,7 +15,8 @@
 //! ([`campaign::assemble_finished`]). `--recover H` trains and scores on the recovered stress target
 //! ([`surrogate::recovery`]) instead of the element stress. `--with FRONT.csv` adds an earlier
 //! front's rows ([`super::front_row`]) to the table and the plot; each row records its settings
-//! (target, training samples, likelihood rows), and rows of other settings are refused. Written
+//! (target, training samples, likelihood rows, phase input), and rows of other settings are
+//! refused. Written
 //! as `front.csv`, `front.md` and `front.png` (Fit against runs, one line per design), each
 //! atomically.
 

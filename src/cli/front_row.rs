@@ -1,10 +1,11 @@
 //! One point of `palpa front`: its cells as `front.csv` and `front.md` write them, and a row
 //! read back from an earlier `front.csv` (`--with`), so that a front measured in another sitting
 //! is drawn beside new designs without its campaigns. Each row carries the settings it was
-//! measured with (target, training samples, likelihood rows; [`super::selection`]), and `--with`
-//! refuses rows measured with other settings than the front's own: their Fits are not
-//! comparable. A `front.csv` written before the `settings` column (9 columns) is read with its
-//! settings unknown, said on stderr.
+//! measured with (target, training samples, likelihood rows, phase input;
+//! [`super::selection::SampleTargetArgs::settings`]), and `--with` refuses rows measured with
+//! other settings than the front's own: their Fits are not comparable. A `front.csv` written
+//! before the `settings` column (9 columns) is read with its settings unknown, said on stderr,
+//! and written back as `unknown`.
 
 use std::path::Path;
 
@@ -14,6 +15,9 @@ pub const CSV_HEADER: &str =
 
 /// The columns of a `front.csv` written before the `settings` column.
 const COLUMNS_BEFORE_SETTINGS: usize = 9;
+
+/// The `settings` cell of a row whose settings are not known.
+const UNKNOWN: &str = "unknown";
 
 /// One point of the front.
 #[derive(Clone, Debug, PartialEq)]
@@ -45,7 +49,12 @@ impl Row {
     /// The row's cells as `front.csv` writes them.
     pub fn csv_cells(&self) -> Vec<String> {
         let mut cells = self.cells(false).to_vec();
-        cells.push(self.settings.clone().unwrap_or_else(|| "unknown".into()));
+        let settings = self.settings.as_deref().unwrap_or(UNKNOWN);
+        debug_assert!(
+            !settings.contains(','),
+            "a settings cell with a comma: {settings}"
+        );
+        cells.push(settings.to_string());
         cells
     }
 
@@ -85,17 +94,14 @@ impl Row {
     pub fn read_fronts(paths: &[std::path::PathBuf], settings: &str) -> Result<Vec<Row>, String> {
         let mut rows: Vec<Row> = Vec::new();
         for path in paths {
-            let mut more = Row::read_csv(path)?;
+            let more = Row::read_csv(path)?;
             if let Some(r) = more.iter().find(|r| r.settings.is_none()) {
                 eprintln!(
-                    "  note: --with {} records no settings (a front.csv older than its `settings` column): its rows, e.g. {} at {} runs, are drawn as if measured with {settings}",
+                    "  note: --with {}: the settings of some rows are unknown (a front.csv older than its `settings` column), e.g. {} at {} runs: they are drawn as they are, not checked against {settings}",
                     path.display(),
                     r.design,
                     r.runs
                 );
-            }
-            for r in more.iter_mut().filter(|r| r.settings.is_none()) {
-                r.settings = Some(settings.to_string());
             }
             if let Some((r, there)) = more.iter().find_map(|r| {
                 r.settings
@@ -143,7 +149,7 @@ impl Row {
             }
             _ => {
                 return Err(format!(
-                    "--with {}:1: not a front.csv (its header must be `{CSV_HEADER}`)",
+                    "--with {}:1: not a front.csv (its header must be `{CSV_HEADER}`, or the same without `,settings`)",
                     path.display()
                 ))
             }
@@ -189,7 +195,8 @@ impl Row {
             train_seconds: num(8)?,
             settings: match cells.get(9) {
                 Some(s) if s.is_empty() => return Err("settings: empty".into()),
-                s => s.map(|s| s.to_string()),
+                Some(&UNKNOWN) | None => None,
+                Some(s) => Some(s.to_string()),
             },
         })
     }
@@ -235,12 +242,21 @@ mod tests {
             err.contains("sobol at 25 runs was measured with element stress; every sample; 600 likelihood rows, this front with recovered"),
             "{err}"
         );
-        // a front.csv of 9 columns reads with its settings unknown
+        // a front.csv of 9 columns reads with its settings unknown, joins a front of any
+        // settings, and writes them as `unknown`, which reads back as unknown
         let old = CSV_HEADER.rsplit_once(',').unwrap().0;
         std::fs::write(&path, format!("{old}\n{}\n", row.cells(false).join(","))).unwrap();
-        let read = Row::read_csv(&path).unwrap();
+        let read = Row::read_fronts(
+            &paths,
+            "recovered H = 5 mm; every sample; 600 likelihood rows",
+        )
+        .unwrap();
         assert_eq!(read[0].settings, None);
         assert_eq!(read[0].fit_all, row.fit_all);
+        let line = read[0].csv_cells().join(",");
+        assert!(line.ends_with(",unknown"), "{line}");
+        std::fs::write(&path, format!("{CSV_HEADER}\n{line}\n")).unwrap();
+        assert_eq!(Row::read_csv(&path).unwrap(), read);
         std::fs::write(
             &path,
             format!("{CSV_HEADER}\n{}\n", line.replace("0.9433", "x")),

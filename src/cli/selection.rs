@@ -57,7 +57,11 @@ impl SampleTargetArgs {
     /// (`gp`, after [`Self::set_likelihood_rows`]) and whether the phase input is left out, e.g.
     /// `element stress; every sample; 600 likelihood rows`.
     pub fn settings(&self, gp: &surrogate::gp::GpOptions) -> Result<String, String> {
-        let short = |v: f64| format!("{}", (v * 1e6).round() / 1e3);
+        // in mm or ms, shortest at 12 significant digits (a unit's conversion leaves no 1e-16)
+        let short = |v: f64| {
+            let v = v * 1e3;
+            format!("{}", format!("{v:.11e}").parse::<f64>().unwrap_or(v))
+        };
         let mut s = match self.recovery_width()? {
             Some(h) => format!("recovered H = {} mm", short(h)),
             None => "element stress".into(),

@@ -210,22 +210,9 @@ impl Dataset {
             (Some(dt), Some(c), Some(tol)) => on_stamp(self.x[(i, c)], dt, tol),
             _ => true,
         };
-        let rows: Vec<usize> = (0..self.n_samples())
-            .filter(|&i| {
-                self.split[i] != crate::Split::Train.code()
-                    || (keep_loc.contains(&self.location[i]) && on_stamp(i))
-            })
-            .collect();
-        if !rows
-            .iter()
-            .any(|&i| self.split[i] == crate::Split::Train.code())
-        {
-            return Err(Error::invalid(
-                "train selection",
-                "keeps no training sample",
-            ));
-        }
-        Ok(self.rows(&rows))
+        self.keep_training("train selection", |i| {
+            keep_loc.contains(&self.location[i]) && on_stamp(i)
+        })
     }
 
     /// The dataset without the training samples of the locations labelled `labels` (test
@@ -236,43 +223,44 @@ impl Dataset {
         let order = self.training_location_order();
         let mut drop: Vec<i64> = Vec::new();
         for l in labels {
+            let bad = |why: String| Error::invalid("leave-out", why);
+            if l.trim().is_empty() {
+                return Err(bad("an empty label".into()));
+            }
             let id = order
                 .iter()
                 .find(|&&id| self.location_label(id) == *l)
-                .ok_or_else(|| {
-                    Error::invalid(
-                        "leave out",
-                        format!("`{l}` is not a training location of the selection"),
-                    )
-                })?;
+                .ok_or_else(|| bad(format!("`{l}` is not a training location of the selection")))?;
+            if drop.contains(id) {
+                return Err(bad(format!("`{l}` is given twice")));
+            }
             drop.push(*id);
         }
+        self.keep_training("leave-out", |i| !drop.contains(&self.location[i]))
+    }
+
+    /// The dataset with the test samples and the training samples `i` for which `keep(i)`
+    /// holds, in order; an error (of `what`) when no training sample is kept.
+    fn keep_training(&self, what: &str, keep: impl Fn(usize) -> bool) -> Result<Dataset> {
         let rows: Vec<usize> = (0..self.n_samples())
-            .filter(|&i| {
-                self.split[i] != crate::Split::Train.code() || !drop.contains(&self.location[i])
-            })
+            .filter(|&i| self.split[i] != crate::Split::Train.code() || keep(i))
             .collect();
         if !rows
             .iter()
             .any(|&i| self.split[i] == crate::Split::Train.code())
         {
-            return Err(Error::invalid("leave out", "keeps no training sample"));
+            return Err(Error::invalid(what, "keeps no training sample"));
         }
-        Ok(self.rows(&rows))
-    }
-
-    /// The dataset of the samples `rows`, in that order.
-    fn rows(&self, rows: &[usize]) -> Dataset {
-        Dataset {
-            x: self.x.select(Axis(0), rows),
-            y: self.y.select(Axis(0), rows),
-            stress: self.stress.as_ref().map(|s| s.select(Axis(0), rows)),
+        Ok(Dataset {
+            x: self.x.select(Axis(0), &rows),
+            y: self.y.select(Axis(0), &rows),
+            stress: self.stress.as_ref().map(|s| s.select(Axis(0), &rows)),
             roi_ids: self.roi_ids.clone(),
             roi_centroids: self.roi_centroids.clone(),
-            location: self.location.select(Axis(0), rows),
-            split: self.split.select(Axis(0), rows),
+            location: self.location.select(Axis(0), &rows),
+            split: self.split.select(Axis(0), &rows),
             manifest: self.manifest.clone(),
-        }
+        })
     }
 
     /// The training locations in the order their first sample appears (a campaign's order).

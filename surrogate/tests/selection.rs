@@ -62,3 +62,20 @@ fn training_locations_are_left_out_by_label() {
         .is_err());
     assert!(first3.without_training_locations(&[first]).is_ok());
 }
+
+/// A label given twice, or an empty one, is refused by name.
+#[test]
+fn leave_out_refuses_a_label_twice_or_empty() {
+    let d = make_synthetic_dataset(4);
+    let first = d.location_label(d.training_location_order()[0]);
+    let err = d
+        .without_training_locations(&[first.clone(), first.clone()])
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains(&format!("`{first}` is given twice")), "{err}");
+    let err = d
+        .without_training_locations(&[String::new()])
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("an empty label"), "{err}");
+}
