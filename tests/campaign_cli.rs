@@ -31,7 +31,7 @@ use surrogate::{Dataset, ViewGeometry};
 
 #[path = "support/cli.rs"]
 mod cli;
-use cli::{ok, palpa, s};
+use cli::{fails_with, ok, palpa, s};
 #[path = "support/mod.rs"]
 mod serve_support;
 #[path = "support/tiny_campaign.rs"]
@@ -754,14 +754,9 @@ fn left_out_locations_are_not_learned(tmp: &Path, campaign: &Path) {
         (&["--leave-out", "A"][..], "A"),
         (&["--train-locations", "1", "--leave-out", "P12"][..], "P12"),
     ] {
-        let o = train(more);
-        let err = String::from_utf8_lossy(&o.stderr);
-        assert!(
-            !o.status.success()
-                && err.contains(&format!(
-                    "`{label}` is not a training location of the selection"
-                )),
-            "{err}"
+        fails_with(
+            &train(more),
+            &format!("`{label}` is not a training location of the selection"),
         );
     }
 }
@@ -897,13 +892,9 @@ fn earlier_front_joins_a_new_one(tmp: &Path, campaign: &Path) {
             "--out",
             s(&joined),
         ]);
-        let err = String::from_utf8_lossy(&o.stderr);
-        assert!(
-            !o.status.success()
-                && err.contains(&format!(
-                    "d at 1 runs was measured with element stress; every sample; 600 likelihood rows, this front with {here}"
-                )),
-            "{err}"
+        fails_with(
+            &o,
+            &format!("d at 1 runs was measured with element stress; every sample; 600 likelihood rows, this front with {here}"),
         );
     }
 }

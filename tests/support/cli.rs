@@ -30,6 +30,15 @@ pub fn ok(args: &[&str]) -> String {
     stdout
 }
 
+/// Asserts that a run of `palpa` failed with `text` in its stderr.
+pub fn fails_with(o: &Output, text: &str) {
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        !o.status.success() && err.contains(text),
+        "expected `{text}`:\n{err}"
+    );
+}
+
 /// Run `palpa predict MODEL --stdin` with `lines` on its stdin; its output.
 pub fn predict_stdin(model: &Path, lines: &[u8]) -> Output {
     use std::io::Write as _;
