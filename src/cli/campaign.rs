@@ -10,8 +10,8 @@
 //!   atomically); `--resume` skips finished runs and redoes any other run directory from
 //!   scratch. Runs copied into a directory without `campaign.json`, and with `--adaptive` a new
 //!   batch's runs already finished there, are reused when their `scene.toml` is the palpation
-//!   the plan gives them ([`Campaign::is_run_as_planned`]: copied from a campaign that plans the
-//!   same runs or chose the same batches), and solved again otherwise;
+//!   the plan gives them ([`Campaign::unlike_plan`]: copied from a campaign that plans the
+//!   same runs or chose the same batches), and removed and solved again otherwise;
 //! - `view.json`: the phantom in plan view (outlines, ROI cells, the hand;
 //!   [`surrogate::ViewGeometry`]), which `palpa train` puts beside the model;
 //! - `dataset.npz` + `manifest.json` (also as `dataset.json`, so that both `palpa train DIR` and
