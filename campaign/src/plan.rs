@@ -20,9 +20,9 @@ pub use surrogate::Split;
 /// ([`crate::first_difference`]); `None` when they give the same palpation.
 fn palpation_difference(there: &str, here: &str) -> Option<String> {
     let untitled = |s: &str| -> Result<serde_json::Value, String> {
-        let mut t: toml::Table = s
-            .parse()
-            .map_err(|e: toml::de::Error| format!("not a scene file: {}", e.message()))?;
+        let mut t: toml::Table = s.parse().map_err(|e: toml::de::Error| {
+            format!("not a scene file: {}", e.message().replace('\n', " "))
+        })?;
         if let Some(run) = t.get_mut("run").and_then(|r| r.as_table_mut()) {
             run.remove("title");
         }
@@ -432,6 +432,9 @@ mod tests {
             Some("scene.run.end_time: \"0.025 s\" there, \"0.03 s\" here")
         );
         let bad = palpation_difference("[run\n", b).unwrap();
-        assert!(bad.starts_with("not a scene file"), "{bad}");
+        assert!(
+            bad.starts_with("not a scene file") && !bad.contains('\n'),
+            "{bad}"
+        );
     }
 }
