@@ -794,11 +794,7 @@ fn likelihood_rows_reach_the_gp(tmp: &Path, campaign: &Path) {
         "--out",
         s(&model),
     ]);
-    let err = String::from_utf8_lossy(&mlp.stderr);
-    assert!(
-        !mlp.status.success() && err.contains("--likelihood-rows sets the GP's"),
-        "{err}"
-    );
+    fails_with(&mlp, "--likelihood-rows sets the GP's");
     for bad in [
         train("1"),
         palpa(&["front", "d=x", "--likelihood-rows", "0", "--out", s(&model)]),
@@ -847,11 +843,9 @@ fn earlier_front_joins_a_new_one(tmp: &Path, campaign: &Path) {
     assert_eq!(new[..old.len()], old[..]);
     assert!(new[old.len()].starts_with("again,1,"), "{new:?}");
     let o = front("d");
-    let err = String::from_utf8_lossy(&o.stderr);
-    assert!(
-        !o.status.success()
-            && err.contains("design `d` at 1 runs is already a point of a --with front"),
-        "{err}"
+    fails_with(
+        &o,
+        "design `d` at 1 runs is already a point of a --with front",
     );
     let o = palpa(&[
         "front",
@@ -863,11 +857,7 @@ fn earlier_front_joins_a_new_one(tmp: &Path, campaign: &Path) {
         "--out",
         s(&joined),
     ]);
-    let err = String::from_utf8_lossy(&o.stderr);
-    assert!(
-        !o.status.success() && err.contains("design `d` at 1 runs is given twice"),
-        "{err}"
-    );
+    fails_with(&o, "design `d` at 1 runs is given twice");
     // the earlier front learned the element stress from every sample: a recovered front, or
     // one with another likelihood cap, refuses it, naming both settings
     for (flag, value, here) in [

@@ -158,7 +158,7 @@ fn run_campaign(a: &CampaignArgs) -> Result<(), String> {
         .iter()
         .map(|r| campaign::is_finished(out, &r.label))
         .collect();
-    let unlike = copied_runs_unlike_plan(&campaign, out, &mine);
+    let unlike = copied_runs_unlike_plan(&campaign, out, &mine, &finished);
     let done: Vec<bool> = mine
         .iter()
         .zip(&finished)
@@ -381,20 +381,22 @@ fn run_and_grow(
     }
 }
 
-/// The finished runs of `mine` copied into `out` before it held a `campaign.json` that are not
+/// The finished runs of `mine` (`finished`) copied into `out` before it held a `campaign.json` that are not
 /// the palpation the plan gives them, with the reason ([`Campaign::unlike_plan`]); none in a
 /// directory this campaign made (its `campaign.json` already says its runs are its own).
 fn copied_runs_unlike_plan(
     campaign: &Campaign,
     out: &Path,
     mine: &[&PlannedRun],
+    finished: &[bool],
 ) -> Vec<(String, String)> {
     if out.join(campaign::CAMPAIGN_FILE).exists() {
         return Vec::new();
     }
     mine.iter()
-        .filter(|r| campaign::is_finished(out, &r.label))
-        .filter_map(|r| Some((r.label.clone(), campaign.unlike_plan(out, r)?)))
+        .zip(finished)
+        .filter(|(_, &f)| f)
+        .filter_map(|(r, _)| Some((r.label.clone(), campaign.unlike_plan(out, r)?)))
         .collect()
 }
 
