@@ -6,7 +6,8 @@ use serde_json::Value;
 
 /// Where two JSON values (two campaign plans, two scenes) first differ, for the message that
 /// refuses to mix them:
-/// `plan.locations[26].surface_m[0]: -0.0705 there, -0.0725 here`. `None` when equal.
+/// `plan.locations[26].surface_m[0]: -0.0705 there, -0.0725 here`. `None` when equal; an
+/// integer and a float of the same value are equal (`25` and `25.0`).
 pub fn first_difference(there: &Value, here: &Value, path: &str) -> Option<String> {
     let short = |v: &Value| {
         let s = v.to_string();
@@ -43,6 +44,8 @@ pub fn first_difference(there: &Value, here: &Value, path: &str) -> Option<Strin
             a.len(),
             b.len()
         )),
+        // TOML and JSON tell `25` from `25.0`; a plan does not.
+        (Value::Number(a), Value::Number(b)) if a.as_f64() == b.as_f64() => None,
         _ if there != here => Some(format!(
             "{path}: {} there, {} here",
             short(there),
@@ -80,7 +83,7 @@ mod tests {
             first_difference(&there, &here, "plan").as_deref(),
             Some("plan.runs: 2 entries there, 3 here")
         );
-        here["runs"] = json!([1, 2]);
+        here["runs"] = json!([1.0, 2.0]);
         assert_eq!(
             first_difference(&there, &here, "plan").as_deref(),
             Some("plan.title: absent there, \"new\" here")

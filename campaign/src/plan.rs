@@ -423,6 +423,13 @@ mod tests {
         let a = "[run]\ntitle = \"Sobol: S001\"\nend_time = \"0.025 s\"\n\n[[hand]]\nat = [\"0.1 m\", \"0.2 m\"]\n";
         let b = "[run]\nend_time = \"0.025 s\"\ntitle = \"adaptive: S001\"\n[[hand]]\nat = [ \"0.1 m\", \"0.2 m\" ]\n";
         assert_eq!(palpation_difference(a, b), None);
+        // an integer and a float of the same value are one palpation; another value is not
+        let c = |v: &str| format!("{a}[phantom]\nfat_scale = {v}\n");
+        assert_eq!(palpation_difference(&c("1"), &c("1.0")), None);
+        assert_eq!(
+            palpation_difference(&c("1"), &c("1.5")).as_deref(),
+            Some("scene.phantom.fat_scale: 1 there, 1.5 here")
+        );
         assert_eq!(
             palpation_difference(a, &b.replace("0.2 m", "0.21 m")).as_deref(),
             Some("scene.hand[0].at[1]: \"0.2 m\" there, \"0.21 m\" here")
