@@ -207,6 +207,26 @@ fn merge_into_a_stale_directory_is_refused(tmp: &Path, merged: &Path, s0: &Path,
     );
     assert!(!other.join("runs").exists(), "nothing copied");
 
+    // the same plan with `26` written `26.0` (a hand-edited campaign.json) is this campaign
+    let refloat = tmp.join("refloat");
+    std::fs::create_dir_all(&refloat).unwrap();
+    let mut v: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(merged.join("campaign.json")).unwrap()).unwrap();
+    let samples = &mut v["plan"]["runs"][0]["samples"];
+    let n = samples.as_u64().expect("samples is an integer");
+    *samples = serde_json::json!(n as f64);
+    std::fs::write(refloat.join("campaign.json"), v.to_string()).unwrap();
+    ok(&[
+        "campaign",
+        "merge",
+        s(s0),
+        s(s1),
+        "--out",
+        s(&refloat),
+        "--quiet",
+    ]);
+    assert_eq!(done_count(&refloat), RUNS);
+
     let unknown = tmp.join("unknown");
     std::fs::create_dir_all(unknown.join("runs").join("P01")).unwrap();
     let o = palpa(&["campaign", "merge", s(s0), s(s1), "--out", s(&unknown)]);

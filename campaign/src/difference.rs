@@ -7,7 +7,8 @@ use serde_json::Value;
 /// Where two JSON values (two campaign plans, two scenes) first differ, for the message that
 /// refuses to mix them:
 /// `plan.locations[26].surface_m[0]: -0.0705 there, -0.0725 here`. `None` when equal; an
-/// integer and a float of the same value are equal (`25` and `25.0`).
+/// integer and a float of the same value are equal (`25` and `25.0`), two integers only when
+/// they are the same integer (beyond 2^53 as well).
 pub fn first_difference(there: &Value, here: &Value, path: &str) -> Option<String> {
     let short = |v: &Value| {
         let s = v.to_string();
@@ -44,8 +45,13 @@ pub fn first_difference(there: &Value, here: &Value, path: &str) -> Option<Strin
             a.len(),
             b.len()
         )),
-        // TOML and JSON tell `25` from `25.0`; a plan does not.
-        (Value::Number(a), Value::Number(b)) if a.as_f64() == b.as_f64() => None,
+        // TOML and JSON tell `25` from `25.0`; a plan does not. Two integers are compared
+        // exactly below (a seed beyond 2^53 is not rounded).
+        (Value::Number(a), Value::Number(b))
+            if (a.is_f64() || b.is_f64()) && a.as_f64() == b.as_f64() =>
+        {
+            None
+        }
         _ if there != here => Some(format!(
             "{path}: {} there, {} here",
             short(there),
@@ -84,6 +90,15 @@ mod tests {
             Some("plan.runs: 2 entries there, 3 here")
         );
         here["runs"] = json!([1.0, 2.0]);
+        assert_eq!(
+            first_difference(
+                &json!([9_007_199_254_740_993u64]),
+                &json!([9_007_199_254_740_992u64]),
+                "seed"
+            )
+            .as_deref(),
+            Some("seed[0]: 9007199254740993 there, 9007199254740992 here")
+        );
         assert_eq!(
             first_difference(&there, &here, "plan").as_deref(),
             Some("plan.title: absent there, \"new\" here")

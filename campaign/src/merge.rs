@@ -56,9 +56,10 @@ pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<MergeReport, String> {
         counts.push(cd.shard.map_or(1, |(_, n)| n));
         match &first {
             None => first = Some(cd),
-            Some(f) if f.plan_value != cd.plan_value => {
-                let diff =
-                    first_difference(&f.plan_value, &cd.plan_value, "plan").unwrap_or_default();
+            Some(f) => {
+                let Some(diff) = first_difference(&f.plan_value, &cd.plan_value, "plan") else {
+                    continue;
+                };
                 return Err(format!(
                     "{} is a different campaign from {} ({diff}; there = {}, here = {})",
                     d.display(),
@@ -67,7 +68,6 @@ pub fn merge(dirs: &[PathBuf], out: &Path) -> Result<MergeReport, String> {
                     d.display()
                 ));
             }
-            _ => {}
         }
     }
     let first = first.ok_or("merge: no directories")?;
@@ -155,8 +155,7 @@ fn refuse_stale_out(out: &Path, plan: &Value, dirs: &[PathBuf]) -> Result<(), St
     let file = out.join(CAMPAIGN_FILE);
     if file.is_file() {
         let v = read_json(&file)?;
-        if v["plan"] != *plan {
-            let diff = first_difference(&v["plan"], plan, "plan").unwrap_or_default();
+        if let Some(diff) = first_difference(&v["plan"], plan, "plan") {
             return Err(format!(
                 "merge: {} holds another campaign ({diff}; there = {}, here = {}); merge into an empty directory or one of this campaign's",
                 out.display(),

@@ -186,7 +186,10 @@ fn run_campaign(a: &CampaignArgs) -> Result<(), String> {
             .truncate(before.locations.len() - last.points.len());
         let there = campaign::read_campaign_dir(out).ok();
         let before_plan = before.plan(&phantom, &locs[..before.locations.len()]);
-        if there.is_some_and(|d| d.plan_value == before_plan.to_value()) {
+        let same = |d: &campaign::CampaignDir| {
+            campaign::first_difference(&d.plan_value, &before_plan.to_value(), "plan").is_none()
+        };
+        if there.is_some_and(|d| same(&d)) {
             campaign::write_campaign_file(out, &plan, None)?;
         }
     }
