@@ -186,10 +186,10 @@ fn run_campaign(a: &CampaignArgs) -> Result<(), String> {
             .truncate(before.locations.len() - last.points.len());
         let there = campaign::read_campaign_dir(out).ok();
         let before_plan = before.plan(&phantom, &locs[..before.locations.len()]);
-        let same = |d: &campaign::CampaignDir| {
-            campaign::first_difference(&d.plan_value, &before_plan.to_value(), "plan").is_none()
-        };
-        if there.is_some_and(|d| same(&d)) {
+        let before_plan = before_plan.to_value();
+        if there.is_some_and(|d| {
+            campaign::first_difference(&d.plan_value, &before_plan, "plan").is_none()
+        }) {
             campaign::write_campaign_file(out, &plan, None)?;
         }
     }
@@ -384,9 +384,10 @@ fn run_and_grow(
     }
 }
 
-/// The finished runs of `mine` (`finished`) copied into `out` before it held a `campaign.json` that are not
-/// the palpation the plan gives them, with the reason ([`Campaign::unlike_plan`]); none in a
-/// directory this campaign made (its `campaign.json` already says its runs are its own).
+/// The finished runs of `mine` (flagged in `finished`) copied into `out` before it held a
+/// `campaign.json` that are not the palpation the plan gives them, with the reason
+/// ([`Campaign::unlike_plan`]); none in a directory this campaign made (its `campaign.json`
+/// already says its runs are its own).
 fn copied_runs_unlike_plan(
     campaign: &Campaign,
     out: &Path,
