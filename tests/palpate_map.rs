@@ -54,6 +54,57 @@ fn palpate_draws_the_stress_picture() {
         hot >= 20,
         "the largest stress's colour {want:?} covers {hot} pixels"
     );
+    force_csv_is_history_and_its_moving_average(&out);
+}
+
+/// `force_indentation.csv` holds history.csv's hand travel and reaction row for row, and as
+/// `force_filtered` their centred 1 ms moving average (recomputed here by its definition,
+/// the mean over |t_j - t_i| <= 0.5 ms), which cannot peak above the raw force and chatters
+/// less (its total variation is smaller).
+fn force_csv_is_history_and_its_moving_average(out: &Path) {
+    let table = |name: &str| -> (Vec<String>, Vec<Vec<f64>>) {
+        let text = std::fs::read_to_string(out.join(name)).unwrap();
+        let mut lines = text.lines();
+        let head = lines.next().unwrap().split(',').map(String::from).collect();
+        let rows = lines
+            .map(|l| l.split(',').map(|v| v.parse().unwrap()).collect())
+            .collect();
+        (head, rows)
+    };
+    let col = |(head, rows): &(Vec<String>, Vec<Vec<f64>>), name: &str| -> Vec<f64> {
+        let k = head.iter().position(|h| h == name).unwrap();
+        rows.iter().map(|r| r[k]).collect()
+    };
+    let history = table("history.csv");
+    let forces = table("force_indentation.csv");
+    let t = col(&forces, "time");
+    let f = col(&forces, "force");
+    let smooth = col(&forces, "force_filtered");
+    assert_eq!(t, col(&history, "time"));
+    assert_eq!(col(&forces, "indentation"), col(&history, "hand_travel"));
+    assert_eq!(f, col(&history, "hand_reaction"));
+    for (i, &ti) in t.iter().enumerate() {
+        let window: Vec<f64> = (0..t.len())
+            .filter(|&j| t[j] >= ti - 0.5e-3 && t[j] <= ti + 0.5e-3)
+            .map(|j| f[j])
+            .collect();
+        let mean = window.iter().sum::<f64>() / window.len() as f64;
+        let tol = 1e-9 * f.iter().fold(1.0, |m: f64, v| m.max(v.abs()));
+        assert!(
+            (smooth[i] - mean).abs() <= tol,
+            "row {i}: {} vs {mean}",
+            smooth[i]
+        );
+    }
+    let top = |v: &[f64]| v.iter().copied().fold(f64::NEG_INFINITY, f64::max);
+    let variation = |v: &[f64]| v.windows(2).map(|w| (w[1] - w[0]).abs()).sum::<f64>();
+    assert!(top(&smooth) <= top(&f) && top(&f) > 0.0);
+    assert!(
+        variation(&smooth) < variation(&f),
+        "{} vs {}",
+        variation(&smooth),
+        variation(&f)
+    );
 }
 
 /// `--fidelity fast` runs the physical hourglass form with the flesh's K/G capped at 5000: the

@@ -14,6 +14,7 @@ use super::run::{print_summary, run_loaded};
 use super::units;
 use scene::palpation::{read_probe, ElementChoice, Fidelity, PalpationSetup, Place, ProbeSamples};
 use solver::output::atomic::write_atomic;
+use solver::output::filter::{moving_average, FORCE_FILTER};
 use solver::output::history::{column, read_history};
 use solver::simulation::StepEstimate;
 use std::fmt::Write;
@@ -272,9 +273,12 @@ pub fn palpate(args: &PalpateArgs) -> Result<(), String> {
     match (&post, &err) {
         (Ok(p), _) => {
             println!(
-                "  peak force {:.2} N at {:.2} mm indentation; ROI max principal stress {:.3} .. {:.3} kPa (peak |.| {:.3} kPa)",
+                "  peak force {:.2} N at {:.2} mm indentation ({:.2} N at {:.2} mm after the {:.0} ms moving average); ROI max principal stress {:.3} .. {:.3} kPa (peak |.| {:.3} kPa)",
                 p.peak_force,
                 p.depth_at_peak * 1e3,
+                p.peak_filtered,
+                p.depth_at_peak_filtered * 1e3,
+                FORCE_FILTER * 1e3,
                 p.stress_min / 1e3,
                 p.stress_max / 1e3,
                 p.stress_min.abs().max(p.stress_max.abs()) / 1e3
@@ -292,8 +296,12 @@ pub fn palpate(args: &PalpateArgs) -> Result<(), String> {
 
 /// Figures of a finished palpation.
 struct Post {
+    /// Peak of the raw hand reaction (N) and the indentation there (m).
     peak_force: f64,
     depth_at_peak: f64,
+    /// Peak of the filtered hand reaction ([`FORCE_FILTER`]) (N) and the indentation there (m).
+    peak_filtered: f64,
+    depth_at_peak_filtered: f64,
     stress_min: f64,
     stress_max: f64,
 }
@@ -306,16 +314,30 @@ struct MapSetup<'a> {
     subtitle: String,
 }
 
-/// Write `roi_stress.csv` and the two plots; return the headline figures.
+/// Index and value of the largest entry (None when empty).
+fn peak(v: &[f64]) -> Option<(usize, f64)> {
+    v.iter()
+        .copied()
+        .enumerate()
+        .max_by(|a, b| a.1.total_cmp(&b.1))
+}
+
+/// Write `roi_stress.csv`, `force_indentation.csv` and the two plots; return the headline
+/// figures. The penalty contact force chatters from one history row to the next, so the force
+/// is reported and plotted also after the centred moving average of
+/// `solver::output::filter` (the filter the campaign's dataset and the studies use).
 fn postprocess(out: &Path, centroids: &[[f64; 3]], map: &MapSetup) -> Result<Post, String> {
     let (cols, rows) = read_history(&out.join("history.csv"))?;
+    let time = column(&cols, &rows, "time").ok_or("history.csv has no time")?;
     let travel = column(&cols, &rows, "hand_travel").ok_or("history.csv has no hand_travel")?;
     let force = column(&cols, &rows, "hand_reaction").ok_or("history.csv has no hand_reaction")?;
-    let (k, &peak) = force
-        .iter()
-        .enumerate()
-        .max_by(|a, b| a.1.total_cmp(b.1))
-        .ok_or("history.csv is empty")?;
+    let filtered = moving_average(&time, &force, FORCE_FILTER);
+    let (k, peak_raw) = peak(&force).ok_or("history.csv is empty")?;
+    let (kf, peak_filtered) = peak(&filtered).ok_or("history.csv is empty")?;
+    write_atomic(
+        &out.join("force_indentation.csv"),
+        force_csv(&time, &travel, &force, &filtered).as_bytes(),
+    )?;
     let probe = read_probe(out, "hand")?;
     write_atomic(
         &out.join("roi_stress.csv"),
@@ -326,14 +348,16 @@ fn postprocess(out: &Path, centroids: &[[f64; 3]], map: &MapSetup) -> Result<Pos
         title: "two-finger palpation: force against indentation".into(),
         axes: ("indentation (mm)".into(), "force (N)".into()),
         log: false,
-        curves: vec![(
-            "palpa".into(),
-            travel
-                .iter()
-                .zip(&force)
-                .map(|(d, f)| (d * 1e3, *f))
-                .collect(),
-        )],
+        curves: [
+            ("hand reaction (raw penalty contact force)", &force),
+            ("centred 1 ms moving average", &filtered),
+        ]
+        .into_iter()
+        .map(|(name, f)| {
+            let points = travel.iter().zip(f).map(|(d, f)| (d * 1e3, *f)).collect();
+            (name.to_string(), points)
+        })
+        .collect(),
     };
     verification::plot::draw(&series, out)?;
     let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
@@ -366,11 +390,23 @@ fn postprocess(out: &Path, centroids: &[[f64; 3]], map: &MapSetup) -> Result<Pos
         }
     }
     Ok(Post {
-        peak_force: peak,
+        peak_force: peak_raw,
         depth_at_peak: travel[k],
+        peak_filtered,
+        depth_at_peak_filtered: travel[kf],
         stress_min: lo,
         stress_max: hi,
     })
+}
+
+/// `time,indentation,force,force_filtered` (s, m, N, N): the hand's travel and reaction at
+/// every history row, raw and after the [`FORCE_FILTER`] centred moving average.
+fn force_csv(time: &[f64], travel: &[f64], force: &[f64], filtered: &[f64]) -> String {
+    let mut s = String::from("time,indentation,force,force_filtered\n");
+    for i in 0..time.len() {
+        let _ = writeln!(s, "{},{},{},{}", time[i], travel[i], force[i], filtered[i]);
+    }
+    s
 }
 
 /// `element,x,y,z,s_<t ms>...`: per ROI element its centroid (m) and its maximum principal
