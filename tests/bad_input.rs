@@ -66,10 +66,14 @@ fn malformed_toml() {
 
 #[test]
 fn unknown_key() {
+    // a material card's key: toml places it at the card's `[materials.NAME]` header; palpa
+    // names its own line
+    let scene = GOOD.replace("poisson_ratio = 0.3", "poisson_ratio = 0.3\nposson = 0.3");
+    let line = 1 + scene.lines().position(|l| l.starts_with("posson")).unwrap();
     bad(
         "unknown_key",
-        &GOOD.replace("poisson_ratio = 0.3", "poisson_ratio = 0.3\nposson = 0.3"),
-        &["posson"],
+        &scene,
+        &["posson", &format!("line {line}, column 1")],
     );
     bad(
         "unknown_key_run",

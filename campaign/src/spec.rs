@@ -301,8 +301,7 @@ impl CampaignSpec {
     pub fn load(path: &Path) -> Result<CampaignSpec, String> {
         let src = std::fs::read_to_string(path)
             .map_err(|e| format!("{}: cannot read the campaign file: {e}", path.display()))?;
-        toml::from_str(&src)
-            .map_err(|e| format!("{}: {}", path.display(), e.to_string().trim_end()))
+        toml::from_str(&src).map_err(|e| material::toml_error::describe(path, &src, &e))
     }
 
     /// Resolve into a campaign (checks values; the phantom is not built here).

@@ -474,8 +474,9 @@ pub fn run_driver_str(text: &str, base_dir: Option<&Path>) -> Result<DriverOutpu
 pub fn run_driver_file(path: &Path) -> Result<String, String> {
     let text = std::fs::read_to_string(path)
         .map_err(|e| format!("cannot read `{}`: {e}", path.display()))?;
-    let out =
-        run_driver_str(&text, path.parent()).map_err(|e| format!("{}: {e}", path.display()))?;
+    let spec: DriverSpec =
+        toml::from_str(&text).map_err(|e| crate::toml_error::describe(path, &text, &e))?;
+    let out = run_driver(&spec, path.parent()).map_err(|e| format!("{}: {e}", path.display()))?;
     Ok(out.to_csv())
 }
 

@@ -21,6 +21,7 @@ pub mod real_avx512;
 pub mod real_f32;
 pub mod spec;
 pub mod tensor;
+pub mod toml_error;
 
 pub use law::{Law, LawError, Response};
 pub use spec::{named, MaterialSpec};

@@ -37,8 +37,8 @@ pub fn load_scene(path: &Path) -> Result<Scene, String> {
 pub fn load_scene_with(path: &Path, prebuilt: Option<Phantom>) -> Result<Scene, String> {
     let src = std::fs::read_to_string(path)
         .map_err(|e| format!("{}: cannot read the scene file: {e}", path.display()))?;
-    let spec: SceneSpec = toml::from_str(&src)
-        .map_err(|e| format!("{}: {}", path.display(), e.to_string().trim_end()))?;
+    let spec: SceneSpec =
+        toml::from_str(&src).map_err(|e| material::toml_error::describe(path, &src, &e))?;
     build_scene_with(spec, path, &src, prebuilt)
 }
 

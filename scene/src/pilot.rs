@@ -94,8 +94,8 @@ pub fn plan(path: &Path, real: &Scene) -> Result<PilotPlan, String> {
     }
     let src = std::fs::read_to_string(path)
         .map_err(|e| format!("{}: cannot read the scene file: {e}", path.display()))?;
-    let mut spec: SceneSpec = toml::from_str(&src)
-        .map_err(|e| format!("{}: {}", path.display(), e.to_string().trim_end()))?;
+    let mut spec: SceneSpec =
+        toml::from_str(&src).map_err(|e| material::toml_error::describe(path, &src, &e))?;
     let mut capped = Vec::new();
     for ps in spec.parts.iter_mut() {
         let Some(part) = m.parts.iter().find(|p| p.name == ps.name) else {
