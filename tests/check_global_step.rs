@@ -6,7 +6,7 @@
 
 #[path = "support/cli.rs"]
 mod cli;
-#[path = "../scene/tests/common/mod.rs"]
+#[path = "../scene/tests/integration/common/mod.rs"]
 mod common;
 
 /// A free 5 x 4 x 4 mm block of 1 mm cubes of a nu = 0.49 linear elastic solid, `run_extra`

@@ -1,6 +1,6 @@
 //! A run whose `probe.csv` was cut mid-row (a campaign killed while a file system lost its
 //! tail): `--resume` reads it back as an error that names the run, the line and what to do,
-//! never a panic (issue 29; the history reader itself is tested in scene/tests/damaged_outputs.rs).
+//! never a panic (issue 29; the history reader itself is tested in scene/tests/integration/damaged_outputs.rs).
 
 const PROBE: &str = "time,hand_reaction,hand_travel,hand_depth,e3,e4\n\
 0.000000000e0,0.000000000e0,0.000000000e0,0.000000000e0,1.0e0,2.0e0\n\

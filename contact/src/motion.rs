@@ -41,7 +41,7 @@
 //! and on a body that collapses it keeps pushing. A held load on one-point hexahedra with
 //! *viscous* hourglass control is such a case (the hourglass modes resist only rates, so the
 //! elements under the indenter drift and flatten during a hold); for force-controlled holds use
-//! stiffness hourglass control or the F-bar element (`scene/tests/contact_force_control.rs`
+//! stiffness hourglass control or the F-bar element (`scene/tests/integration/contact_force_control.rs`
 //! measures both, and checks that the depth holds still).
 
 use crate::curve::Curve;

@@ -171,7 +171,7 @@ pub trait ForceStage: Send {
 /// neo-Hookean solid went unstable within 30 steps at factors 0.85-0.9 (a linear-elastic
 /// nu = 0.49 block too, with bulk viscosity and hourglass control off, so neither causes it).
 /// With kappa, 0.9 leaves the usual 10 % margin for any Poisson ratio
-/// (`scene/tests/stable_step.rs`). A run that goes unstable anyway stops with an error
+/// (`scene/tests/integration/stable_step.rs`). A run that goes unstable anyway stops with an error
 /// (negative internal energy) instead of producing garbage.
 pub const DEFAULT_DT_FACTOR: f64 = 0.9;
 

@@ -3,7 +3,7 @@
 //! Reference: F = 2 a E* d, E* = E/(1 - nu^2) (rigid flat punch on an elastic half-space).
 //! Tolerance (issue 4): 5 % at d = 0.05, 0.075 and 0.1 mm (d/a <= 0.05, small strain).
 
-mod common;
+use crate::common;
 use scene::load_scene;
 use solver::output::history::column;
 use std::path::Path;

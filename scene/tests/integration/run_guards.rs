@@ -10,7 +10,7 @@
 //!   [`solver::element::full::MIN_GAUSS_VOLUME_RATIO`]) before any Gauss point inverts, naming
 //!   element 0, and must not produce a NaN.
 
-mod common;
+use crate::common;
 use scene::build::build_scene;
 use scene::run::run_scene;
 use scene::SceneSpec;

@@ -11,7 +11,7 @@
 //!   pressed fast (20 % of the height in 1 ms, a smooth step peaking at 3.75 m/s) close their
 //!   energy balance to 1 %.
 
-mod common;
+use crate::common;
 use scene::build::build_scene;
 use scene::SceneSpec;
 use solver::element::surface_mode_factor;

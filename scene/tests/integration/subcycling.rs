@@ -6,7 +6,7 @@
 //! integrated over the macro step) within 1 % (the 3 mm figures are in docs/performance.md,
 //! "Subcycling"). A bad setting is refused naming the key.
 
-mod common;
+use crate::common;
 
 use scene::palpation::PalpationSetup;
 

@@ -5,7 +5,7 @@
 //! answer on fewer steps, and a fast, crushing press gives the same bits on one and two
 //! threads.
 
-mod common;
+use crate::common;
 use nalgebra::{DMatrix, Vector3};
 use scene::Scene;
 use solver::hex::element_geometry;

@@ -31,7 +31,7 @@
 //! element (`full_fbar`, no hourglass modes) the same scene holds 20 N within 0.42 % (mean
 //! 19.999 N), as here.
 
-mod common;
+use crate::common;
 use solver::output::history::column;
 
 const SCENE: &str = r#"

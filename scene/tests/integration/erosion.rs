@@ -8,7 +8,7 @@
 //! energy balance must still close (the eroded element's stored energy stays in the internal
 //! work it received).
 
-mod common;
+use crate::common;
 use scene::run::run_scene;
 use solver::output::history::{column, read_history};
 use std::sync::atomic::AtomicBool;

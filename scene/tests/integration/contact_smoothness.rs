@@ -3,7 +3,7 @@
 //! largest value, every step-to-step change |F_(n+1) - F_n| stays below 5 % of |F_n| (F the
 //! reaction along the pressing direction, every step).
 
-mod common;
+use crate::common;
 
 fn scene(motion: &str, center: &str) -> String {
     format!(

@@ -3,7 +3,7 @@
 //! E* = E/(1 - nu^2), for a rigid sphere on an elastic half-space. Tolerance (issue 4): 5 % at
 //! every compared depth d/R = 0.02 ... 0.1; the energy error (contact energy included) below 2 %.
 
-mod common;
+use crate::common;
 use scene::load_scene;
 use solver::output::history::column;
 use std::path::Path;

@@ -11,7 +11,7 @@
 //!   reported, and the energy balance (which counts the kinetic energy of the added mass) stays
 //!   within 1 %.
 
-mod common;
+use crate::common;
 use solver::output::history::column;
 
 fn scene(grading: f64, end: &str, crush: &str, mass_scaling: &str) -> String {

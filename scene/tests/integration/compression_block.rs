@@ -4,7 +4,7 @@
 //! and the nominal stress P_33 = l_z [mu (1 - l_z^-2) + lambda ln J / l_z^2]; the support
 //! reaction is -P_33 A0. Tolerances from issue 2: 0.5 % on the force, energy error < 1 %.
 
-mod common;
+use crate::common;
 use scene::build::build_scene;
 use scene::{load_scene, SceneSpec};
 use solver::output::history::column;

@@ -3,7 +3,7 @@
 //! 12 hexahedra and two parts of equal volume, with the part names, node sets and element sets
 //! each format carries; cells palpa does not mesh are refused with their counts.
 
-mod common;
+use crate::common;
 
 use solver::mesh_io::read_mesh;
 use solver::Mesh;

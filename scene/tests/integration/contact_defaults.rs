@@ -4,7 +4,7 @@
 //! once the contact is established), and the energy error, contact energy included, within 2 %
 //! (after the first 10 % of the run).
 
-mod common;
+use crate::common;
 use scene::load_scene;
 use solver::output::history::column;
 use std::path::Path;

@@ -6,7 +6,7 @@
 //!   one step far longer than the interval (a huge stable step) looped for as many intervals as
 //!   the step spanned, or for ever once `next + dt` rounded back to `next`.
 
-mod common;
+use crate::common;
 use scene::run::{next_output_time, run_scene};
 use solver::output::history::read_history;
 use std::sync::atomic::AtomicBool;

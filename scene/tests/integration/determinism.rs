@@ -2,7 +2,7 @@
 //! are added into each node in a fixed order (colour, then element order) and chunk partial sums are reduced in chunk order;
 //! run-time mass scaling adds its mass serially in element order.
 
-mod common;
+use crate::common;
 use scene::Scene;
 
 use common::PRESSED_BLOCK as SCENE;

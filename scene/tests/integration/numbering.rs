@@ -4,7 +4,7 @@
 //! with the fixed face given both as a plane and as explicit node ids of the mesh as generated
 //! (which the renumbering must carry along). The phantom refuses a numbering.
 
-mod common;
+use crate::common;
 
 use scene::build::build_scene;
 use scene::SceneSpec;

@@ -4,7 +4,7 @@
 //! the viscous form by sqrt of that ratio (c -> c sqrt(2 mu / (lambda + 2 mu))). Any other value is
 //! refused with a message that names the key.
 
-mod common;
+use crate::common;
 use scene::build::build_scene;
 use scene::SceneSpec;
 use std::path::Path;

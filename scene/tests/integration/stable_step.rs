@@ -6,7 +6,7 @@
 //! factor 0.9 (a free-surface mode up to 1/0.825 times faster than the interior bound L / c).
 //! The eigenvalue study behind kappa is `verification/python/hex_stability_eigen.py`.
 
-mod common;
+use crate::common;
 use solver::element::surface_mode_factor;
 use solver::output::history::column;
 
