@@ -49,7 +49,7 @@ for t in "${targets[@]}"; do
     timeout_ms=1000
     [ "$t" = scene ] && timeout_ms=5000
     cargo afl fuzz -i "corpus/$t" -o "$out/$t" -V "$secs" -t "$timeout_ms" -m 4096 \
-        "target/release/$t" >"$out/$t.log" 2>&1 || {
+        "${CARGO_TARGET_DIR:-target}/release/$t" >"$out/$t.log" 2>&1 || {
         echo "   $t: afl-fuzz failed to run:"
         tail -n 20 "$out/$t.log"
         failed+=("$t")
