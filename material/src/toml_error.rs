@@ -7,6 +7,11 @@
 //! unknown field and points at a table header, [`describe`] points at the line of that key in
 //! that table instead, in toml's own layout (line, column, the line with the key underlined).
 //! Every other error is toml's message as it is.
+//!
+//! The field may belong to a table nested in the card (a Prony term's `modulus` and `tau`), and
+//! its name may also be a key of the card itself (`density`). [`name_nested`] tells the two
+//! apart by the fields serde expected, and names the nested table in the message, which
+//! [`describe`] then leaves at the header rather than underline the card's own, valid key.
 
 use std::path::Path;
 
@@ -21,15 +26,25 @@ pub fn describe(path: &Path, src: &str, e: &toml::de::Error) -> String {
         return whole;
     };
     let gutter = " ".repeat(line.to_string().len());
-    let key_len = text[column - 1..]
-        .find(|c: char| c == '=' || c.is_whitespace())
-        .unwrap_or(text.len() - column + 1)
-        .max(1);
+    // the indentation as it is (tabs stay tabs, so the carets line up), then one caret a
+    // character of the key, quotes included
+    let (indent, key) = text.split_at(column - 1);
+    let key_chars = match key.strip_prefix(['"', '\'']) {
+        Some(rest) => 2 + rest.chars().take_while(|&c| c != '"' && c != '\'').count(),
+        None => key
+            .chars()
+            .take_while(|&c| c != '=' && !c.is_whitespace())
+            .count(),
+    };
+    let pad: String = indent
+        .chars()
+        .map(|c| if c == '\t' { '\t' } else { ' ' })
+        .collect();
     format!(
-        "{}: TOML parse error at line {line}, column {column}\n{gutter} |\n{line} | {text}\n{gutter} | {}{}\n{}",
+        "{}: TOML parse error at line {line}, column {}\n{gutter} |\n{line} | {text}\n{gutter} | {pad}{}\n{}",
         path.display(),
-        " ".repeat(column - 1),
-        "^".repeat(key_len),
+        indent.chars().count() + 1,
+        "^".repeat(key_chars.max(1)),
         e.message().trim_end()
     )
 }
@@ -38,6 +53,49 @@ pub fn describe(path: &Path, src: &str, e: &toml::de::Error) -> String {
 fn unknown_field(message: &str) -> Option<&str> {
     let rest = message.strip_prefix("unknown field `")?;
     rest.split('`').next().filter(|f| !f.is_empty())
+}
+
+/// The fields serde's message lists after `expected` (none for "there are no fields").
+fn expected_fields(message: &str) -> Vec<&str> {
+    message
+        .split_once(", expected")
+        .map_or(Vec::new(), |(_, rest)| {
+            rest.split('`').skip(1).step_by(2).collect()
+        })
+}
+
+/// serde's message for a card read from `card`, with ``in `KEY` (entry N): `` before it when
+/// the struct that refused the unknown field is a table nested in the card (its keys, not the
+/// card's, are the expected fields and the unknown one). The message is returned as it is when
+/// the card's own keys fit, or when no nested table does.
+pub fn name_nested(card: &toml::Table, message: &str) -> String {
+    let Some(field) = unknown_field(message) else {
+        return message.to_string();
+    };
+    let expected = expected_fields(message);
+    let fits = |t: &toml::Table, skip: &str| {
+        t.contains_key(field)
+            && t.keys()
+                .all(|k| k == field || k == skip || expected.contains(&k.as_str()))
+    };
+    if fits(card, "law") {
+        return message.to_string();
+    }
+    for (key, value) in card {
+        let place = match value {
+            toml::Value::Table(t) if fits(t, "") => format!("`{key}`"),
+            toml::Value::Array(items) => match items
+                .iter()
+                .position(|item| item.as_table().is_some_and(|t| fits(t, "")))
+            {
+                Some(i) => format!("`{key}` (entry {})", i + 1),
+                None => continue,
+            },
+            _ => continue,
+        };
+        return format!("in {place}: {message}");
+    }
+    message.to_string()
 }
 
 /// When byte `at` of `src` lies on a table header (`[a.b]` or `[[a]]`), the first line of that
@@ -102,6 +160,42 @@ mod tests {
         // quoted, with spaces before `=`
         let m = message(&src.replace("  shear_modulas =", "\"shear_modulas\"   ="));
         assert!(m.contains("line 5, column 1"), "{m}");
+    }
+
+    #[test]
+    fn a_nested_field_named_like_a_card_key_is_not_placed_on_the_card_s_key() {
+        // a Prony term's unknown `density`: the card's own `density` (line 3) is valid
+        let card = "[materials.a]\nlaw = \"ogden\"\ndensity = \"1000 kg/m^3\"\nmu = [\"1 kPa\"]\nalpha = [2.0]\nbulk_modulus = \"1 MPa\"\n";
+        for prony in [
+            "[[materials.a.prony]]\nmodulus = \"1 kPa\"\ndensity = 3.0\n",
+            "prony = [{ modulus = \"1 kPa\", tau = \"1 ms\" }, { modulus = \"1 kPa\", density = 2.0 }]\n",
+        ] {
+            let src = if prony.starts_with('[') {
+                format!("{card}{prony}")
+            } else {
+                card.replace("mu =", &format!("{prony}mu ="))
+            };
+            let m = message(&src);
+            assert!(!m.contains("line 3"), "{m}");
+            assert!(m.contains("in `prony` (entry "), "{m}");
+            assert!(m.contains("unknown field `density`, expected"), "{m}");
+        }
+        // the nested term's own line is not found from the card's header: toml's place stays
+        let m = message(&format!(
+            "{card}[[materials.a.prony]]\nmodulus = \"1 kPa\"\ntaux = 1.0\n"
+        ));
+        assert!(
+            m.contains("in `prony` (entry 1): unknown field `taux`"),
+            "{m}"
+        );
+    }
+
+    #[test]
+    fn carets_count_characters_and_keep_tabs() {
+        let src = "[materials.rubber]\nlaw = \"neo_hookean\"\n\t\"dénsité x\" = 1.0\n";
+        let m = message(src);
+        assert!(m.contains("line 3, column 2\n"), "{m}");
+        assert!(m.contains("\n  | \t^^^^^^^^^^^\n"), "{m}");
     }
 
     #[test]

@@ -6,7 +6,9 @@
 //! - `probe.csv` / `probe_stress.csv`: the ROI's stresses every 5 ms;
 //! - `roi_stress.csv`: per ROI element its centroid and maximum principal stress at each sample;
 //! - `roi.csv`, `locations.json`: the ROI and the palpation locations of the phantom;
-//! - `force_indentation.png` and `roi_stress_map.png` (the ROI's maximum principal stress at the
+//! - `force_indentation.csv`: the hand's travel and reaction at every history row, raw and after
+//!   the 1 ms centred moving average;
+//! - `force_indentation.png` (both curves) and `roi_stress_map.png` (the ROI's maximum principal stress at the
 //!   end of the press in plan view, with the phantom's outlines and the fingers, drawn as
 //!   `palpa serve` draws a prediction: [`surrogate::render_picture`]).
 
