@@ -62,19 +62,10 @@ fn palpate_draws_the_stress_picture() {
 /// the mean over |t_j - t_i| <= 0.5 ms), which cannot peak above the raw force and chatters
 /// less (its total variation is smaller).
 fn force_csv_is_history_and_its_moving_average(out: &Path) {
-    let table = |name: &str| -> (Vec<String>, Vec<Vec<f64>>) {
-        let text = std::fs::read_to_string(out.join(name)).unwrap();
-        let mut lines = text.lines();
-        let head = lines.next().unwrap().split(',').map(String::from).collect();
-        let rows = lines
-            .map(|l| l.split(',').map(|v| v.parse().unwrap()).collect())
-            .collect();
-        (head, rows)
-    };
-    let col = |(head, rows): &(Vec<String>, Vec<Vec<f64>>), name: &str| -> Vec<f64> {
-        let k = head.iter().position(|h| h == name).unwrap();
-        rows.iter().map(|r| r[k]).collect()
-    };
+    use solver::output::history::{column, read_history};
+    let table = |name: &str| read_history(&out.join(name)).unwrap();
+    let col =
+        |(head, rows): &(Vec<String>, Vec<Vec<f64>>), name: &str| column(head, rows, name).unwrap();
     let history = table("history.csv");
     let forces = table("force_indentation.csv");
     let t = col(&forces, "time");

@@ -212,12 +212,9 @@ impl<'de> Deserialize<'de> for MaterialSpec {
                     )),
                 }
             }
-            toml::Value::Table(t) => TaggedCard::deserialize(v.clone())
+            _ => TaggedCard::deserialize(v.clone())
                 .map(MaterialSpec::from)
-                .map_err(|e| D::Error::custom(crate::toml_error::name_nested(t, e.message()))),
-            _ => TaggedCard::deserialize(v)
-                .map(MaterialSpec::from)
-                .map_err(|e| D::Error::custom(e.message())),
+                .map_err(|e| D::Error::custom(crate::toml_error::name_nested(&v, e.message()))),
         }
     }
 }

@@ -67,9 +67,9 @@ fn expected_fields(message: &str) -> Vec<&str> {
 /// serde's message for a card read from `card`, with ``in `KEY` (entry N): `` before it when
 /// the struct that refused the unknown field is a table nested in the card (its keys, not the
 /// card's, are the expected fields and the unknown one). The message is returned as it is when
-/// the card's own keys fit, or when no nested table does.
-pub fn name_nested(card: &toml::Table, message: &str) -> String {
-    let Some(field) = unknown_field(message) else {
+/// the card's own keys fit, or when no nested table does (or the card is no table).
+pub fn name_nested(card: &toml::Value, message: &str) -> String {
+    let (Some(field), Some(card)) = (unknown_field(message), card.as_table()) else {
         return message.to_string();
     };
     let expected = expected_fields(message);
@@ -107,12 +107,12 @@ fn key_in_table<'a>(src: &'a str, at: usize, field: &str) -> Option<(usize, usiz
     if !lines.next()?.trim_start().starts_with('[') {
         return None;
     }
+    let quoted = [format!("\"{field}\""), format!("'{field}'")];
     for (k, text) in lines.enumerate() {
         let key = text.trim_start();
         if key.starts_with('[') {
             return None;
         }
-        let quoted = [format!("\"{field}\""), format!("'{field}'")];
         let sets = [field, &quoted[0], &quoted[1]].into_iter().any(|n| {
             key.strip_prefix(n)
                 .is_some_and(|rest| rest.trim_start().starts_with('='))
